@@ -1,0 +1,661 @@
+//! The one config loader: TOML file + `--set KEY=VALUE` overrides → validated
+//! cases. Unknown keys are errors naming the key (and the line, when it comes
+//! from the file). Units are in the key names; the cases carry SI.
+
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use solver::case::CaseSpec;
+use solver::material::{Elasticity, Isotropic, Material};
+use solver::surface::{Island, Surface};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// `[grid]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridCfg {
+    /// N: the surface grid is N x N cells.
+    pub points: usize,
+    /// Cell size, µm.
+    pub spacing_um: f64,
+}
+
+/// `[indenter]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IndenterCfg {
+    /// Sphere radius, mm.
+    pub radius_mm: f64,
+}
+
+/// `[load]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadCfg {
+    /// Normal load P, N.
+    pub normal_n: f64,
+    /// Coulomb friction μ.
+    pub friction: f64,
+    /// F = ratio · μ · P; 0 = normal contact only.
+    #[serde(default = "default_ratio")]
+    pub tangential_ratio: f64,
+}
+
+fn default_ratio() -> f64 {
+    0.6
+}
+
+/// Force angles: `{ start, stop, step }` (stop included) or a list.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AnglesCfg {
+    /// Inclusive range.
+    Range {
+        /// First angle, degrees.
+        start: f64,
+        /// Last angle (included when hit), degrees.
+        stop: f64,
+        /// Step, degrees.
+        step: f64,
+    },
+    /// Explicit list, degrees.
+    List(Vec<f64>),
+}
+
+impl AnglesCfg {
+    /// The angles, degrees.
+    pub fn values(&self) -> Result<Vec<f64>> {
+        match self {
+            AnglesCfg::List(v) => {
+                if v.is_empty() || v.iter().any(|a| !a.is_finite()) {
+                    bail!("sweep.angles_deg: the list must be non-empty and finite");
+                }
+                Ok(v.clone())
+            }
+            AnglesCfg::Range { start, stop, step } => {
+                if !(start.is_finite() && stop.is_finite() && step.is_finite())
+                    || *step <= 0.0
+                    || stop < start
+                {
+                    bail!("sweep.angles_deg: need finite start ≤ stop and step > 0, got start = {start}, stop = {stop}, step = {step}");
+                }
+                let count = ((stop - start) / step + 1e-9).floor() as usize + 1;
+                if count > 100_000 {
+                    bail!("sweep.angles_deg: {count} angles is too many");
+                }
+                Ok((0..count).map(|k| start + k as f64 * step).collect())
+            }
+        }
+    }
+}
+
+/// `[sweep]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepCfg {
+    /// Preset names or keys of `[materials.*]`.
+    pub materials: Vec<String>,
+    /// Preset names or keys of `[surfaces.*]`.
+    #[serde(default = "default_surfaces")]
+    pub surfaces: Vec<String>,
+    /// Force directions.
+    #[serde(default = "default_angles")]
+    pub angles_deg: AnglesCfg,
+}
+
+fn default_surfaces() -> Vec<String> {
+    vec!["flat".into()]
+}
+
+fn default_angles() -> AnglesCfg {
+    AnglesCfg::List(vec![0.0])
+}
+
+/// Isotropic constants in GPa.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsoCfg {
+    /// Young's modulus, GPa.
+    pub youngs_gpa: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+}
+
+/// Cubic constants in GPa.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CubicCfg {
+    /// C11, GPa.
+    pub c11: f64,
+    /// C12, GPa.
+    pub c12: f64,
+    /// C44, GPa.
+    pub c44: f64,
+}
+
+/// `[materials.NAME]`: exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialCfg {
+    /// Isotropic constants.
+    pub isotropic: Option<IsoCfg>,
+    /// Full 6x6 Voigt stiffness in the surface frame (xx, yy, zz, yz, xz, xy; z into the body), GPa.
+    pub stiffness_gpa: Option<Vec<Vec<f64>>>,
+    /// Cubic constants, rotated so that z ∥ `normal` and x ∥ `x_dir`.
+    pub cubic_gpa: Option<CubicCfg>,
+    /// Surface normal (Miller indices) for `cubic_gpa`.
+    pub normal: Option<[f64; 3]>,
+    /// In-plane x direction (Miller indices) for `cubic_gpa`.
+    pub x_dir: Option<[f64; 3]>,
+    /// Isotropic-equivalent constants for normalisation (default: Hill average).
+    pub equivalent: Option<IsoCfg>,
+}
+
+/// `[surfaces.NAME]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceCfg {
+    /// `flat`, `circle` or `square`.
+    pub shape: String,
+    /// Circle diameter, µm.
+    pub diameter_um: Option<f64>,
+    /// Square side, µm.
+    pub side_um: Option<f64>,
+    /// Lattice pitch, µm.
+    pub pitch_um: Option<f64>,
+    /// Island height, µm (negative: dimples).
+    pub height_um: Option<f64>,
+    /// Position of one island centre relative to the sphere apex, µm.
+    #[serde(default)]
+    pub offset_um: [f64; 2],
+}
+
+/// `[solver]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverCfg {
+    /// Normal–tangential coupling.
+    #[serde(default = "yes")]
+    pub coupling: bool,
+    /// Normal solver: relative change of pressure.
+    #[serde(default = "default_tol")]
+    pub tolerance: f64,
+    /// Tangential solver: KKT residual relative to |δt|.
+    #[serde(default = "default_ttol")]
+    pub tangential_tolerance: f64,
+    /// Iteration budget of each inner solve.
+    #[serde(default = "default_iter")]
+    pub max_iterations: usize,
+    /// Coupling loop: relative change of pressure.
+    #[serde(default = "default_ctol")]
+    pub coupling_tolerance: f64,
+    /// Coupling loop budget.
+    #[serde(default = "default_citer")]
+    pub max_coupling_iterations: usize,
+}
+
+fn yes() -> bool {
+    true
+}
+fn default_tol() -> f64 {
+    1e-10
+}
+fn default_ttol() -> f64 {
+    1e-6
+}
+fn default_iter() -> usize {
+    5000
+}
+fn default_ctol() -> f64 {
+    1e-8
+}
+fn default_citer() -> usize {
+    50
+}
+
+impl Default for SolverCfg {
+    fn default() -> Self {
+        SolverCfg {
+            coupling: true,
+            tolerance: default_tol(),
+            tangential_tolerance: default_ttol(),
+            max_iterations: default_iter(),
+            coupling_tolerance: default_ctol(),
+            max_coupling_iterations: default_citer(),
+        }
+    }
+}
+
+/// `[output]`
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputCfg {
+    /// Write `.npy` fields and PNG maps of every case of a sweep.
+    #[serde(default)]
+    pub save_fields: bool,
+}
+
+/// The whole config file.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// `[grid]`
+    pub grid: GridCfg,
+    /// `[indenter]`
+    pub indenter: IndenterCfg,
+    /// `[load]`
+    pub load: LoadCfg,
+    /// `[sweep]`
+    pub sweep: SweepCfg,
+    /// `[materials.*]`
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialCfg>,
+    /// `[surfaces.*]`
+    #[serde(default)]
+    pub surfaces: BTreeMap<String, SurfaceCfg>,
+    /// `[solver]`
+    #[serde(default)]
+    pub solver: SolverCfg,
+    /// `[output]`
+    #[serde(default)]
+    pub output: OutputCfg,
+}
+
+/// A case's identity in a sweep: `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`.
+pub fn case_id(material: &str, surface: &str, angle_deg: f64) -> String {
+    format!("{material}/{surface}/{angle_deg:05.1}")
+}
+
+/// Applies one `KEY=VALUE` override to a TOML table. VALUE is read as TOML
+/// (`128`, `true`, `[1, 2]`, `"Cu"`); anything that is not TOML is a string.
+fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
+    let (key, value) = set
+        .split_once('=')
+        .ok_or_else(|| anyhow!("--set {set}: expected KEY=VALUE"))?;
+    let key = key.trim();
+    let parsed: toml::Value = match format!("v = {}", value.trim()).parse::<toml::Table>() {
+        Ok(mut t) => t
+            .remove("v")
+            .unwrap_or(toml::Value::String(value.to_string())),
+        Err(_) => toml::Value::String(value.trim().to_string()),
+    };
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        bail!("--set {set}: malformed key `{key}`");
+    }
+    let mut cur = table;
+    for p in &parts[..parts.len() - 1] {
+        let entry = cur
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        cur = entry
+            .as_table_mut()
+            .ok_or_else(|| anyhow!("--set {set}: `{p}` is not a table"))?;
+    }
+    cur.insert(parts[parts.len() - 1].to_string(), parsed);
+    Ok(())
+}
+
+/// Hill average of a stiffness: isotropic constants for normalisation.
+fn hill_average(c: &nalgebra::Matrix6<f64>) -> Option<Isotropic> {
+    let s = c.try_inverse()?;
+    let kv = (c[(0, 0)] + c[(1, 1)] + c[(2, 2)] + 2.0 * (c[(0, 1)] + c[(0, 2)] + c[(1, 2)])) / 9.0;
+    let gv = (c[(0, 0)] + c[(1, 1)] + c[(2, 2)] - (c[(0, 1)] + c[(0, 2)] + c[(1, 2)])
+        + 3.0 * (c[(3, 3)] + c[(4, 4)] + c[(5, 5)]))
+        / 15.0;
+    let kr = 1.0 / (s[(0, 0)] + s[(1, 1)] + s[(2, 2)] + 2.0 * (s[(0, 1)] + s[(0, 2)] + s[(1, 2)]));
+    let gr = 15.0
+        / (4.0 * (s[(0, 0)] + s[(1, 1)] + s[(2, 2)]) - 4.0 * (s[(0, 1)] + s[(0, 2)] + s[(1, 2)])
+            + 3.0 * (s[(3, 3)] + s[(4, 4)] + s[(5, 5)]));
+    let (k, g) = (0.5 * (kv + kr), 0.5 * (gv + gr));
+    Some(Isotropic {
+        youngs: 9.0 * k * g / (3.0 * k + g),
+        poisson: (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)),
+    })
+}
+
+impl Config {
+    /// Reads a config file and applies `--set` overrides.
+    pub fn load(path: &Path, sets: &[String]) -> Result<Config> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read config {}", path.display()))?;
+        Self::parse(&text, sets).with_context(|| format!("in config {}", path.display()))
+    }
+
+    /// Parses config text and applies `--set` overrides.
+    pub fn parse(text: &str, sets: &[String]) -> Result<Config> {
+        // First pass on the text itself: errors carry line and column.
+        let cfg: Config = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        if sets.is_empty() {
+            cfg.check()?;
+            return Ok(cfg);
+        }
+        let mut table: toml::Table = text.parse().map_err(|e| anyhow!("{e}"))?;
+        for s in sets {
+            apply_set(&mut table, s)?;
+        }
+        let cfg: Config = toml::Value::Table(table)
+            .try_into()
+            .map_err(|e| anyhow!("after --set {}: {e}", sets.join(" --set ")))?;
+        cfg.check()?;
+        Ok(cfg)
+    }
+
+    /// The effective config as TOML (echoed into outputs; compared on resume).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Everything that can be checked before any solve; errors name the key.
+    pub fn check(&self) -> Result<()> {
+        if self.sweep.materials.is_empty() {
+            bail!("sweep.materials: list at least one material");
+        }
+        if self.sweep.surfaces.is_empty() {
+            bail!("sweep.surfaces: list at least one surface");
+        }
+        self.sweep.angles_deg.values()?;
+        for (_, spec) in self.cases()? {
+            spec.validate().map_err(|e| anyhow!("{e}"))?;
+        }
+        // Memory: nine kernel spectra of (2N)(N+1) complex values plus work buffers.
+        let n = self.grid.points as f64;
+        let bytes = 13.0 * 2.0 * n * (n + 1.0) * 16.0 + 40.0 * n * n * 8.0;
+        if bytes > 16.0 * 1024f64.powi(3) {
+            bail!(
+                "grid.points = {}: a worker would need about {:.1} GiB; use at most 2048",
+                self.grid.points,
+                bytes / 1024f64.powi(3)
+            );
+        }
+        Ok(())
+    }
+
+    /// Resolves a material name: `[materials.NAME]` first, then presets.
+    pub fn material(&self, name: &str) -> Result<Material> {
+        if let Some(m) = self.materials.get(name) {
+            return build_material(name, m);
+        }
+        solver::presets::material(name).ok_or_else(|| {
+            anyhow!("sweep.materials: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
+        })
+    }
+
+    /// Resolves a surface name: `[surfaces.NAME]` first, then presets.
+    pub fn surface(&self, name: &str) -> Result<Surface> {
+        if let Some(s) = self.surfaces.get(name) {
+            return build_surface(name, s);
+        }
+        solver::presets::surface(name).ok_or_else(|| {
+            anyhow!("sweep.surfaces: unknown surface `{name}` (presets: flat, circle-A, circle-B, square-A, square-B; or define [surfaces.\"{name}\"])")
+        })
+    }
+
+    /// One case spec.
+    pub fn spec(&self, material: &str, surface: &str, angle_deg: f64) -> Result<CaseSpec> {
+        Ok(CaseSpec {
+            material: self.material(material)?,
+            surface: self.surface(surface)?,
+            grid_points: self.grid.points,
+            spacing_m: self.grid.spacing_um * 1e-6,
+            indenter_radius_m: self.indenter.radius_mm * 1e-3,
+            normal_force_n: self.load.normal_n,
+            friction: self.load.friction,
+            tangential_ratio: self.load.tangential_ratio,
+            angle_deg,
+            coupling: self.solver.coupling,
+            tolerance: self.solver.tolerance,
+            tangential_tolerance: self.solver.tangential_tolerance,
+            max_iterations: self.solver.max_iterations,
+            coupling_tolerance: self.solver.coupling_tolerance,
+            max_coupling_iterations: self.solver.max_coupling_iterations,
+        })
+    }
+
+    /// All cases of the sweep in a fixed order: materials × surfaces × angles.
+    pub fn cases(&self) -> Result<Vec<(String, CaseSpec)>> {
+        let angles = self.sweep.angles_deg.values()?;
+        let mut out = Vec::new();
+        for m in &self.sweep.materials {
+            for s in &self.sweep.surfaces {
+                for &a in &angles {
+                    out.push((case_id(m, s, a), self.spec(m, s, a)?));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn build_material(name: &str, m: &MaterialCfg) -> Result<Material> {
+    let key = |k: &str| format!("materials.{name}.{k}");
+    let given = [
+        m.isotropic.is_some(),
+        m.stiffness_gpa.is_some(),
+        m.cubic_gpa.is_some(),
+    ]
+    .iter()
+    .filter(|&&b| b)
+    .count();
+    if given != 1 {
+        bail!("materials.{name}: give exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`");
+    }
+    if let Some(iso) = m.isotropic {
+        if m.normal.is_some() || m.x_dir.is_some() {
+            bail!(
+                "{}: `normal`/`x_dir` only apply to `cubic_gpa`",
+                key("normal")
+            );
+        }
+        return Material::isotropic(name, iso.youngs_gpa * 1e9, iso.poisson)
+            .map_err(|e| anyhow!("materials.{name}: {e}"));
+    }
+    let c = if let Some(rows) = &m.stiffness_gpa {
+        if rows.len() != 6 || rows.iter().any(|r| r.len() != 6) {
+            bail!(
+                "{}: must be 6 rows of 6 numbers (GPa)",
+                key("stiffness_gpa")
+            );
+        }
+        nalgebra::Matrix6::from_fn(|i, j| rows[i][j] * 1e9)
+    } else {
+        let cub = m.cubic_gpa.expect("counted above");
+        let normal = m
+            .normal
+            .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("normal")))?;
+        let x_dir = m
+            .x_dir
+            .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("x_dir")))?;
+        solver::aniso::crystal::cubic_stiffness_rotated(
+            cub.c11 * 1e9,
+            cub.c12 * 1e9,
+            cub.c44 * 1e9,
+            normal,
+            x_dir,
+        )
+        .map_err(|e| anyhow!("materials.{name}: {e}"))?
+    };
+    solver::material::check_stiffness(&c).map_err(|e| anyhow!("{}: {e}", key("stiffness")))?;
+    let equivalent = match m.equivalent {
+        Some(e) => Isotropic {
+            youngs: e.youngs_gpa * 1e9,
+            poisson: e.poisson,
+        },
+        None => {
+            hill_average(&c).ok_or_else(|| anyhow!("{}: singular stiffness", key("stiffness")))?
+        }
+    };
+    Ok(Material {
+        name: name.to_string(),
+        elasticity: Elasticity::Anisotropic(c),
+        equivalent,
+    })
+}
+
+fn build_surface(name: &str, s: &SurfaceCfg) -> Result<Surface> {
+    let need = |v: Option<f64>, k: &str| {
+        v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{}\"", s.shape))
+    };
+    let um = 1e-6;
+    let surface = match s.shape.as_str() {
+        "flat" => Surface::Flat,
+        "circle" | "square" => {
+            let island = if s.shape == "circle" {
+                Island::Circle {
+                    diameter: need(s.diameter_um, "diameter_um")? * um,
+                }
+            } else {
+                Island::Square {
+                    side: need(s.side_um, "side_um")? * um,
+                }
+            };
+            Surface::Lattice {
+                island,
+                pitch: need(s.pitch_um, "pitch_um")? * um,
+                height: need(s.height_um, "height_um")? * um,
+                offset: [s.offset_um[0] * um, s.offset_um[1] * um],
+            }
+        }
+        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square)"),
+    };
+    surface
+        .validate()
+        .map_err(|e| anyhow!("surfaces.{name}: {e}"))?;
+    Ok(surface)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BASE: &str = r#"
+[grid]
+points = 64
+spacing_um = 2.0
+
+[indenter]
+radius_mm = 18.0
+
+[load]
+normal_n = 20.0
+friction = 0.3
+tangential_ratio = 0.6
+
+[sweep]
+materials = ["Fe"]
+surfaces = ["flat"]
+angles_deg = { start = 0, stop = 90, step = 45 }
+"#;
+
+    fn err(text: &str, sets: &[&str]) -> String {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        format!("{:#}", Config::parse(text, &sets).unwrap_err())
+    }
+
+    #[test]
+    fn base_config_expands_to_three_cases_in_order() {
+        let c = Config::parse(BASE, &[]).unwrap();
+        let ids: Vec<String> = c.cases().unwrap().into_iter().map(|(id, _)| id).collect();
+        assert_eq!(ids, ["Fe/flat/000.0", "Fe/flat/045.0", "Fe/flat/090.0"]);
+    }
+
+    #[test]
+    fn unknown_key_is_named_with_its_line() {
+        let text = BASE.replace("friction = 0.3", "friction = 0.3\nfriction_coef = 0.2");
+        let e = err(&text, &[]);
+        assert!(e.contains("friction_coef") && e.contains("line 12"), "{e}");
+    }
+
+    #[test]
+    fn wrong_type_is_named() {
+        let e = err(&BASE.replace("points = 64", "points = \"many\""), &[]);
+        assert!(e.contains("points") || e.contains("invalid type"), "{e}");
+    }
+
+    #[test]
+    fn set_overrides_a_key_and_rejects_unknown_ones() {
+        let c = Config::parse(
+            BASE,
+            &["grid.points=128".into(), "load.tangential_ratio=0".into()],
+        )
+        .unwrap();
+        assert_eq!(c.grid.points, 128);
+        assert_eq!(c.load.tangential_ratio, 0.0);
+        let e = err(BASE, &["grid.pointz=128"]);
+        assert!(e.contains("pointz"), "{e}");
+    }
+
+    #[test]
+    fn impossible_values_name_their_key() {
+        let cases: [(&str, &str, &str); 9] = [
+            (
+                "tangential_ratio = 0.6",
+                "tangential_ratio = 1.0",
+                "gross sliding",
+            ),
+            ("normal_n = 20.0", "normal_n = -5.0", "load.normal_n"),
+            ("normal_n = 20.0", "normal_n = nan", "load.normal_n"),
+            ("radius_mm = 18.0", "radius_mm = 0.0", "indenter.radius_mm"),
+            ("spacing_um = 2.0", "spacing_um = inf", "grid.spacing_um"),
+            ("points = 64", "points = 4", "grid.points"),
+            ("points = 64", "points = 100000", "grid.points"),
+            ("friction = 0.3", "friction = -0.1", "load.friction"),
+            (
+                "materials = [\"Fe\"]",
+                "materials = [\"Unobtainium\"]",
+                "Unobtainium",
+            ),
+        ];
+        for (from, to, expect) in cases {
+            let e = err(&BASE.replace(from, to), &[]);
+            assert!(e.contains(expect), "{to}: {e}");
+        }
+    }
+
+    #[test]
+    fn bad_materials_and_surfaces_are_explained() {
+        let poisson = format!(
+            "{BASE}\n[materials.rubber]\nisotropic = {{ youngs_gpa = 0.01, poisson = 0.6 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"rubber\"]");
+        assert!(err(&poisson, &[]).contains("(-1, 0.5]"));
+        let zero_e = format!(
+            "{BASE}\n[materials.void]\nisotropic = {{ youngs_gpa = 0.0, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"void\"]");
+        assert!(err(&zero_e, &[]).contains("Young"));
+        let mut rows = vec![vec![0.0; 6]; 6];
+        rows[0][0] = 100.0;
+        let not_pd = format!("{BASE}\n[materials.bad]\nstiffness_gpa = {rows:?}\n")
+            .replace("materials = [\"Fe\"]", "materials = [\"bad\"]");
+        assert!(
+            err(&not_pd, &[]).contains("positive definite"),
+            "{}",
+            err(&not_pd, &[])
+        );
+        let island = format!("{BASE}\n[surfaces.fat]\nshape = \"circle\"\ndiameter_um = 50.0\npitch_um = 40.0\nheight_um = 1.0\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"fat\"]");
+        assert!(
+            err(&island, &[]).contains("does not fit"),
+            "{}",
+            err(&island, &[])
+        );
+        let nan_h = format!("{BASE}\n[surfaces.odd]\nshape = \"square\"\nside_um = 10.0\npitch_um = 40.0\nheight_um = nan\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"odd\"]");
+        assert!(err(&nan_h, &[]).contains("height"), "{}", err(&nan_h, &[]));
+    }
+
+    #[test]
+    fn cubic_material_with_111_normal_reproduces_the_fe111_preset() {
+        // Back-fitted cubic constants of Fe (see docs/validation.md), frame z ∥ [111], x ∥ [11-2].
+        let text = format!(
+            "{BASE}\n[materials.fe111]\ncubic_gpa = {{ c11 = 257.120, c12 = 125.913, c44 = 108.576 }}\nnormal = [1, 1, 1]\nx_dir = [1, 1, -2]\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"fe111\"]");
+        let c = Config::parse(&text, &[]).unwrap();
+        let mine = c.material("fe111").unwrap().stiffness();
+        let preset = solver::presets::material("Fe(111)").unwrap().stiffness();
+        let worst = (mine - preset).amax();
+        assert!(worst < 0.05e9, "max deviation {worst:e} Pa");
+    }
+}

@@ -1,0 +1,9 @@
+//! # mpcontact coordinator
+//!
+//! The `mpcontact` command line: config loading (`config`), single in-process
+//! solves (`solve`), the multi-process sweep runner over iceoryx2 (`run`), and
+//! the files they write. Physics lives in `solver`; messages in `protocol`.
+
+pub mod config;
+pub mod run;
+pub mod solve;

@@ -1,0 +1,255 @@
+//! `mpcontact`: frictional contact of a rigid sphere on an (an)isotropic,
+//! micropatterned half-space — single solves, kernels, materials, and sweeps
+//! over worker processes. Thin: parses arguments and wires the libraries.
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Parser, Subcommand};
+use coordinator::config::Config;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "mpcontact",
+    version,
+    about = "Frictional contact of a sphere on an (an)isotropic, micropatterned half-space"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run a sweep (materials × surfaces × force angles) on worker processes.
+    Run {
+        /// Config file (default: configs/quick.toml).
+        config: Option<PathBuf>,
+        /// Number of worker processes (default: number of cores).
+        #[arg(long)]
+        workers: Option<usize>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Continue an interrupted sweep from DIR/journal.jsonl.
+        #[arg(long)]
+        resume: bool,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+        /// Also write the fields of every case (fields/<case>/).
+        #[arg(long)]
+        save_fields: bool,
+        /// Override one config key, e.g. --set grid.points=128.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+    },
+    /// Solve one case in-process and write case.json and the fields.
+    Solve {
+        /// Config file.
+        config: PathBuf,
+        /// Material (default: the sweep's first).
+        #[arg(long)]
+        material: Option<String>,
+        /// Surface (default: the sweep's first).
+        #[arg(long)]
+        surface: Option<String>,
+        /// Force direction in degrees (default: the sweep's first).
+        #[arg(long = "angle-deg", allow_hyphen_values = true)]
+        angle_deg: Option<f64>,
+        /// Output directory.
+        #[arg(long, default_value = "out-solve")]
+        out: PathBuf,
+        /// Override one config key.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+    },
+    /// Print the Fourier-domain surface compliance H(θ) of a material as JSON.
+    Kernel {
+        /// Material preset name.
+        #[arg(long)]
+        material: String,
+        /// Angles START:STOP:STEP in degrees (stop included).
+        #[arg(long = "angles-deg", default_value = "0:180:15")]
+        angles_deg: String,
+    },
+    /// List the preset materials and their constants.
+    Materials,
+    /// Worker process (started by `run`).
+    Worker {
+        /// Run id to attach to.
+        #[arg(long)]
+        run: String,
+        /// Worker index (unique within the run; default derived from the pid).
+        #[arg(long)]
+        index: Option<usize>,
+    },
+}
+
+fn parse_angles(s: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let bad = || anyhow!("--angles-deg {s}: expected START:STOP:STEP, e.g. 0:180:15");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let v: Vec<f64> = parts
+        .iter()
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    coordinator::config::AnglesCfg::Range {
+        start: v[0],
+        stop: v[1],
+        step: v[2],
+    }
+    .values()
+}
+
+fn kernel_json(material: &str, angles: &[f64]) -> Result<String> {
+    let m = solver::presets::material(material).ok_or_else(|| {
+        anyhow!("--material {material}: unknown preset (see `mpcontact materials`)")
+    })?;
+    let c = m.stiffness();
+    let rows: Vec<serde_json::Value> = angles
+        .iter()
+        .map(|&deg| {
+            let h = solver::aniso::stroh::surface_compliance(&c, deg.to_radians());
+            let part = |f: fn(&num_complex::Complex64) -> f64| -> Vec<Vec<f64>> {
+                (0..3)
+                    .map(|i| (0..3).map(|j| f(&h[(i, j)])).collect())
+                    .collect()
+            };
+            serde_json::json!({
+                "material": material,
+                "theta_deg": deg,
+                "H_re": part(|z| z.re),
+                "H_im": part(|z| z.im),
+            })
+        })
+        .collect();
+    Ok(serde_json::to_string_pretty(&rows)?)
+}
+
+fn materials_table() -> String {
+    let mut s = String::from("name       kind         E_eq_GPa  nu_eq   constants (GPa)\n");
+    for m in solver::presets::materials() {
+        let (kind, consts) = match &m.elasticity {
+            solver::material::Elasticity::Isotropic(i) => (
+                "isotropic",
+                format!("E = {:.2}, nu = {}", i.youngs / 1e9, i.poisson),
+            ),
+            solver::material::Elasticity::Anisotropic(c) => {
+                let mut parts = Vec::new();
+                for i in 0..6 {
+                    for j in i..6 {
+                        if c[(i, j)] != 0.0 {
+                            parts.push(format!("C{}{} = {}", i + 1, j + 1, c[(i, j)] / 1e9));
+                        }
+                    }
+                }
+                ("anisotropic", parts.join(", "))
+            }
+        };
+        s.push_str(&format!(
+            "{:<10} {:<12} {:>8.2}  {:<6}  {}\n",
+            m.name,
+            kind,
+            m.equivalent.youngs / 1e9,
+            m.equivalent.poisson,
+            consts
+        ));
+    }
+    s.push_str("\n(111) crystals: Table 2 stiffness in the surface frame z ∥ [111] (into the body), x ∥ [1,1,-2];\nE_eq, nu_eq are the paper's isotropic-equivalent values, used to normalise.\n");
+    s
+}
+
+fn real_main() -> Result<()> {
+    match Cli::parse().cmd {
+        Cmd::Run {
+            config,
+            workers,
+            out,
+            resume,
+            quiet,
+            save_fields,
+            sets,
+        } => {
+            let path = config.unwrap_or_else(|| PathBuf::from("configs/quick.toml"));
+            let config = Config::load(&path, &sets)?;
+            let workers = workers.unwrap_or_else(|| {
+                std::thread::available_parallelism()
+                    .map(|n| n.get())
+                    .unwrap_or(1)
+            });
+            if workers == 0 {
+                bail!("--workers must be at least 1");
+            }
+            let args = coordinator::run::RunArgs {
+                config,
+                workers,
+                out_dir: out,
+                resume,
+                quiet,
+                save_fields,
+                exe: std::env::current_exe().context("cannot locate the mpcontact executable")?,
+            };
+            coordinator::run::run_sweep(&args)?;
+            Ok(())
+        }
+        Cmd::Solve {
+            config,
+            material,
+            surface,
+            angle_deg,
+            out,
+            sets,
+        } => {
+            let cfg = Config::load(&config, &sets)?;
+            let s = coordinator::solve::run_solve(
+                &cfg,
+                &coordinator::solve::SolveArgs {
+                    material: material.as_deref(),
+                    surface: surface.as_deref(),
+                    angle_deg,
+                    out: &out,
+                },
+            )?;
+            println!(
+                "a = {:.6e} m, c = {:.6e} m, δz = {:.6e} m, δt = {:.6e} m, p_max = {:.6e} Pa, μa = {}, converged = {} → {}",
+                s.contact_radius_m,
+                s.stick_radius_m,
+                s.delta_z_m,
+                s.delta_t_m,
+                s.p_max_pa,
+                s.mu_a.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
+                s.converged,
+                out.join("case.json").display()
+            );
+            Ok(())
+        }
+        Cmd::Kernel {
+            material,
+            angles_deg,
+        } => {
+            println!("{}", kernel_json(&material, &parse_angles(&angles_deg)?)?);
+            Ok(())
+        }
+        Cmd::Materials => {
+            print!("{}", materials_table());
+            Ok(())
+        }
+        Cmd::Worker { run, index } => {
+            worker::run_worker(&run, index.unwrap_or(1000 + std::process::id() as usize))
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,392 @@
+//! The files a sweep writes: `results.csv`, `curves.csv`, `mu_a_vs_angle.{png,svg}`
+//! and `fields/<case>/*.npy`. Formatting is deterministic (rows sorted by case
+//! id, shortest round-trip floats) so that the CSVs do not depend on the
+//! number of workers. Owns no IPC and no physics beyond the K_E calibration
+//! call into the solver.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use solver::case::{calibrate_k_e, mu_apparent, CaseScalars};
+use solver::surface::Surface;
+
+use super::journal::Record;
+use super::plan::PlannedCase;
+
+/// Header of `results.csv` (DESIGN.md).
+pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker";
+/// Header of `curves.csv`.
+pub const CURVES_HEADER: &str = "material,surface,angle_deg,mu_a";
+
+/// A finished case ready for output: its plan entry, its record and the
+/// scalars after K_E calibration.
+pub struct Row<'a> {
+    /// Plan entry.
+    pub case: &'a PlannedCase,
+    /// Journal record.
+    pub record: &'a Record,
+    /// Scalars with the final μa and K_E.
+    pub scalars: Option<CaseScalars>,
+}
+
+/// Deterministic float text: shortest round-trip digits, exponent form
+/// outside [1e-3, 1e7).
+pub fn fmt_f64(v: f64) -> String {
+    if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e7) || !v.is_finite() {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// Surface name of a case: the part of its id between material and angle.
+pub fn surface_name(case: &PlannedCase) -> String {
+    let rest = case
+        .id
+        .strip_prefix(&format!("{}/", case.spec.material.name))
+        .unwrap_or(&case.id);
+    match rest.rsplit_once('/') {
+        Some((s, _)) => s.to_string(),
+        None => rest.to_string(),
+    }
+}
+
+/// Apply the K_E calibration: patterned (and flat) cases of anisotropic
+/// materials get K_E(ψ) from the flat case of the same material, grid and
+/// angle, and μa recomputed with it. Cases without a flat twin keep the
+/// worker's isotropic-equivalent K_E.
+pub fn calibrate<'a>(
+    cases: &'a [PlannedCase],
+    records: &'a BTreeMap<String, Record>,
+) -> Vec<Row<'a>> {
+    let mut rows = Vec::new();
+    for case in cases {
+        let Some(record) = records.get(&case.id) else {
+            continue;
+        };
+        let mut scalars = record.scalars.clone();
+        if let Some(s) = scalars.as_mut() {
+            let spec = &case.spec;
+            if !spec.material.is_isotropic() && spec.tangential_ratio > 0.0 {
+                let twin = cases.iter().find(|c| {
+                    matches!(c.spec.surface, Surface::Flat)
+                        && c.spec.material == spec.material
+                        && c.spec.grid_points == spec.grid_points
+                        && c.spec.spacing_m.to_bits() == spec.spacing_m.to_bits()
+                        && c.spec.angle_deg.to_bits() == spec.angle_deg.to_bits()
+                });
+                let flat = twin
+                    .and_then(|t| records.get(&t.id))
+                    .filter(|r| r.status != "failed")
+                    .and_then(|r| r.scalars.as_ref());
+                if let Some(flat) = flat {
+                    let k_e = calibrate_k_e(flat, spec.friction, spec.normal_force_n);
+                    s.k_e = k_e;
+                    s.k_e_source = "flat-calibrated".into();
+                    s.mu_a = Some(mu_apparent(s, spec.normal_force_n, k_e));
+                }
+            }
+        }
+        rows.push(Row {
+            case,
+            record,
+            scalars,
+        });
+    }
+    rows.sort_by(|a, b| a.case.id.cmp(&b.case.id));
+    rows
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map(fmt_f64).unwrap_or_default()
+}
+
+/// Text of `results.csv`.
+pub fn results_csv(rows: &[Row]) -> String {
+    let mut out = String::from(RESULTS_HEADER);
+    out.push('\n');
+    for r in rows {
+        let c = r.case;
+        let s = r.scalars.as_ref();
+        let f = |g: fn(&CaseScalars) -> f64| opt(s.map(g));
+        let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{}",
+            csv_field(&c.spec.material.name),
+            csv_field(&surface_name(c)),
+            fmt_f64(c.spec.angle_deg),
+            r.record.status,
+            opt(s.and_then(|s| s.mu_a)),
+            f(|s| s.k_e),
+            f(|s| s.contact_radius_m),
+            f(|s| s.stick_radius_m),
+            f(|s| s.delta_t_m),
+            f(|s| s.delta_z_m),
+            f(|s| s.p_max_pa),
+            f(|s| s.contact_area_m2),
+            f(|s| s.stick_area_m2),
+            i(|s| s.normal_iterations),
+            i(|s| s.tangential_iterations),
+            i(|s| s.coupling_iterations),
+            r.record.seconds,
+            r.record.worker
+        );
+    }
+    out
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Rows that belong on a curve: solved, converged, with a μa.
+pub fn curve_points<'a>(rows: &'a [Row]) -> Vec<(&'a Row<'a>, f64)> {
+    rows.iter()
+        .filter(|r| r.record.status == "ok")
+        .filter_map(|r| r.scalars.as_ref().and_then(|s| s.mu_a).map(|m| (r, m)))
+        .collect()
+}
+
+/// Text of `curves.csv`.
+pub fn curves_csv(rows: &[Row]) -> String {
+    let mut out = String::from(CURVES_HEADER);
+    out.push('\n');
+    for (r, mu) in curve_points(rows) {
+        let _ = writeln!(
+            out,
+            "{},{},{},{}",
+            csv_field(&r.case.spec.material.name),
+            csv_field(&surface_name(r.case)),
+            fmt_f64(r.case.spec.angle_deg),
+            fmt_f64(mu)
+        );
+    }
+    out
+}
+
+/// Curves keyed by "material / surface": (angle, μa) sorted by angle.
+pub fn curves(rows: &[Row]) -> BTreeMap<String, Vec<(f64, f64)>> {
+    let mut m: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    for (r, mu) in curve_points(rows) {
+        m.entry(format!(
+            "{} / {}",
+            r.case.spec.material.name,
+            surface_name(r.case)
+        ))
+        .or_default()
+        .push((r.case.spec.angle_deg, mu));
+    }
+    for v in m.values_mut() {
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    m
+}
+
+/// Draw μa versus angle, one line per material × surface, to `path`
+/// (PNG or SVG by extension).
+pub fn plot_curves(path: &Path, curves: &BTreeMap<String, Vec<(f64, f64)>>) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    let is_svg = path.extension().is_some_and(|e| e == "svg");
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, plotters::coord::Shift>,
+        curves: &BTreeMap<String, Vec<(f64, f64)>>,
+    ) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let pts = curves.values().flatten();
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut xlo, mut xhi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &(a, m) in pts {
+            lo = lo.min(m);
+            hi = hi.max(m);
+            xlo = xlo.min(a);
+            xhi = xhi.max(a);
+        }
+        if !lo.is_finite() {
+            (lo, hi, xlo, xhi) = (0.0, 1.0, 0.0, 180.0);
+        }
+        let pad = ((hi - lo) * 0.1).max(1e-3);
+        if xhi <= xlo {
+            xhi = xlo + 1.0;
+        }
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption("apparent friction vs force angle", ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(xlo..xhi, (lo - pad)..(hi + pad))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        chart
+            .configure_mesh()
+            .x_desc("force angle ψ (deg)")
+            .y_desc("μa")
+            .draw()
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        for (k, (name, pts)) in curves.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?
+                .label(name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        Ok(())
+    }
+    if is_svg {
+        draw(
+            SVGBackend::new(path, (900, 600)).into_drawing_area(),
+            curves,
+        )
+    } else {
+        draw(
+            BitMapBackend::new(path, (900, 600)).into_drawing_area(),
+            curves,
+        )
+    }
+    .with_context(|| format!("while drawing {}", path.display()))
+}
+
+/// Directory of a case's fields: `fields/<material>/<surface>/<angle>`, each
+/// component of the case id made file-name safe.
+pub fn fields_dir(out_dir: &Path, case_id: &str) -> PathBuf {
+    let mut p = out_dir.join("fields");
+    for part in case_id.split('/') {
+        let safe: String = part
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || "._-()+".contains(c) {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        p.push(if safe.is_empty() || safe == "." || safe == ".." {
+            "_".to_string()
+        } else {
+            safe
+        });
+    }
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn float_text_is_shortest_round_trip() {
+        for v in [0.0, 0.3, 1.0 / 3.0, 1.5e-5, 6.02e23, -2.5e-12, 1234.5] {
+            let t = fmt_f64(v);
+            assert_eq!(t.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{t}");
+        }
+        assert_eq!(fmt_f64(1.5e-5), "1.5e-5");
+        assert_eq!(fmt_f64(15.0), "15");
+    }
+
+    fn aniso_case(id: &str, surface: Surface) -> PlannedCase {
+        let iso = solver::material::Isotropic::new(130e9, 0.34).unwrap();
+        let mut c = iso.stiffness();
+        c[(0, 0)] *= 1.2;
+        let spec = solver::case::CaseSpec {
+            material: solver::material::Material {
+                name: "Cu(111)".into(),
+                elasticity: solver::material::Elasticity::Anisotropic(c),
+                equivalent: iso,
+            },
+            surface,
+            grid_points: 32,
+            spacing_m: 1e-4,
+            indenter_radius_m: 0.2,
+            normal_force_n: 6000.0,
+            friction: 0.3,
+            tangential_ratio: 0.6,
+            angle_deg: 30.0,
+            coupling: false,
+            tolerance: 1e-8,
+            tangential_tolerance: 1e-6,
+            max_iterations: 100,
+            coupling_tolerance: 1e-6,
+            max_coupling_iterations: 5,
+        };
+        let mut plan = super::super::plan::Plan::new(vec![(id.to_string(), spec)]);
+        plan.cases.remove(0)
+    }
+
+    fn record(id: &str, a: f64, c: f64, dt: f64) -> Record {
+        Record {
+            case_id: id.into(),
+            status: "ok".into(),
+            error: None,
+            worker: 0,
+            seconds: 1.0,
+            kernel_builds: 1,
+            scalars: Some(CaseScalars {
+                contact_radius_m: a,
+                stick_radius_m: c,
+                delta_t_m: dt,
+                mu_a: Some(0.0),
+                k_e: 1.0,
+                ..Default::default()
+            }),
+        }
+    }
+
+    #[test]
+    fn anisotropic_mu_a_uses_k_e_from_the_flat_twin() {
+        let lattice = Surface::Lattice {
+            island: solver::surface::Island::Circle { diameter: 4e-4 },
+            pitch: 1.28e-3,
+            height: 3e-5,
+            offset: [0.0, 0.0],
+        };
+        let flat = aniso_case("Cu(111)/flat/030.0", Surface::Flat);
+        let pat = aniso_case("Cu(111)/circle-A/030.0", lattice);
+        assert!(flat.calibration && !pat.calibration);
+        let cases = vec![pat, flat];
+        let mut records = BTreeMap::new();
+        records.insert(
+            cases[1].id.clone(),
+            record(&cases[1].id, 2e-3, 1.5e-3, 3e-6),
+        );
+        records.insert(
+            cases[0].id.clone(),
+            record(&cases[0].id, 2.5e-3, 1.4e-3, 4e-6),
+        );
+        let rows = calibrate(&cases, &records);
+        let flat_row = rows.iter().find(|r| r.case.id.contains("flat")).unwrap();
+        let pat_row = rows.iter().find(|r| r.case.id.contains("circle")).unwrap();
+        let fs = flat_row.scalars.as_ref().unwrap();
+        // By construction Eq. 19 with the calibrated K_E returns μ on the flat case.
+        assert!((fs.mu_a.unwrap() - 0.3).abs() < 1e-12, "{:?}", fs.mu_a);
+        let k_e = calibrate_k_e(records[&cases[1].id].scalars.as_ref().unwrap(), 0.3, 6000.0);
+        let ps = pat_row.scalars.as_ref().unwrap();
+        assert_eq!(ps.k_e, k_e);
+        assert_eq!(ps.k_e_source, "flat-calibrated");
+        let want = mu_apparent(records[&cases[0].id].scalars.as_ref().unwrap(), 6000.0, k_e);
+        assert_eq!(ps.mu_a.unwrap(), want);
+        assert_eq!(surface_name(pat_row.case), "circle-A");
+    }
+
+    #[test]
+    fn fields_dir_is_safe() {
+        let d = fields_dir(Path::new("/o"), "Cu(111)/../045.0");
+        assert_eq!(d, Path::new("/o/fields/Cu(111)/_/045.0"));
+    }
+}

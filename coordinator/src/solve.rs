@@ -1,0 +1,117 @@
+//! `mpcontact solve`: one case in-process (no IPC), for inspection — writes
+//! `case.json` and the fields as `.npy`. Also the `.npy` writer shared with `run`.
+
+use crate::config::Config;
+use anyhow::{anyhow, Context, Result};
+use npyz::WriterBuilder;
+use serde::Serialize;
+use solver::case::{
+    calibrate_k_e, mu_apparent, solve_case, CaseScalars, CaseSpec, Fields, KernelCache,
+};
+use solver::material::Elasticity;
+use solver::surface::Surface;
+use std::io::BufWriter;
+use std::path::Path;
+
+/// Writes one `n x n` field as a 2-D float64 `.npy` (rows = y, columns = x).
+pub fn write_npy(path: &Path, n: usize, data: &[f64]) -> Result<()> {
+    let file =
+        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut w = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(&[n as u64, n as u64])
+        .writer(BufWriter::new(file))
+        .begin_nd()?;
+    w.extend(data.iter().copied())?;
+    w.finish()?;
+    Ok(())
+}
+
+/// Writes every field of a case into `dir` as `<name>.npy`.
+pub fn write_fields(dir: &Path, fields: &Fields) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    for (name, data) in fields.named() {
+        write_npy(&dir.join(format!("{name}.npy")), fields.n, data)?;
+    }
+    Ok(())
+}
+
+/// What `case.json` holds.
+#[derive(Serialize)]
+struct CaseJson<'a> {
+    material: &'a str,
+    surface: &'a str,
+    angle_deg: f64,
+    status: &'static str,
+    #[serde(flatten)]
+    scalars: &'a CaseScalars,
+    apparent_radius_definition: &'static str,
+    grid_points: usize,
+    spacing_m: f64,
+    spec: &'a CaseSpec,
+}
+
+/// Options of `mpcontact solve`.
+pub struct SolveArgs<'a> {
+    /// Material name (default: the sweep's first).
+    pub material: Option<&'a str>,
+    /// Surface name (default: the sweep's first).
+    pub surface: Option<&'a str>,
+    /// Force angle (default: the sweep's first).
+    pub angle_deg: Option<f64>,
+    /// Output directory.
+    pub out: &'a Path,
+}
+
+/// Solves one case of `config` and writes its outputs; returns its scalars.
+pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
+    let material = args.material.unwrap_or(&config.sweep.materials[0]);
+    let surface = args.surface.unwrap_or(&config.sweep.surfaces[0]);
+    let angle = match args.angle_deg {
+        Some(a) => a,
+        None => config.sweep.angles_deg.values()?[0],
+    };
+    let spec = config.spec(material, surface, angle)?;
+    spec.validate().map_err(|e| anyhow!("{e}"))?;
+    let mut cache = KernelCache::new();
+    let out =
+        solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
+    let mut scalars = out.scalars;
+    // Anisotropic material on a patterned surface: K_E from the flat twin (PHYSICS.md §7).
+    if matches!(spec.material.elasticity, Elasticity::Anisotropic(_)) && scalars.mu_a.is_some() {
+        let k_e = if spec.surface == Surface::Flat {
+            calibrate_k_e(&scalars, spec.friction, spec.normal_force_n)
+        } else {
+            let mut flat = spec.clone();
+            flat.surface = Surface::Flat;
+            let f = solve_case(&flat, &mut cache).map_err(|e| anyhow!("flat twin for K_E: {e}"))?;
+            calibrate_k_e(&f.scalars, spec.friction, spec.normal_force_n)
+        };
+        scalars.k_e = k_e;
+        scalars.k_e_source = "flat-calibrated".into();
+        scalars.mu_a = Some(mu_apparent(&scalars, spec.normal_force_n, k_e));
+    }
+    std::fs::create_dir_all(args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let json = CaseJson {
+        material,
+        surface,
+        angle_deg: angle,
+        status: if scalars.converged {
+            "ok"
+        } else {
+            "not-converged"
+        },
+        scalars: &scalars,
+        apparent_radius_definition:
+            "radius of the circle with the area of the convex hull of the contact (stick) cells",
+        grid_points: spec.grid_points,
+        spacing_m: spec.spacing_m,
+        spec: &spec,
+    };
+    let path = args.out.join("case.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_fields(args.out, &out.fields)?;
+    Ok(scalars)
+}

@@ -1,0 +1,58 @@
+//! # mpcontact protocol
+//!
+//! What the coordinator and its workers say to each other, and nothing else:
+//! the message types, the wire format, the protocol version, the service and
+//! node names of a run, and the one iceoryx2 [`Config`](iceoryx2::config::Config)
+//! every process of a run must share. No physics: case specifications and
+//! result scalars are carried as type parameters chosen by the caller.
+//!
+//! ## Wire format
+//!
+//! Every message is one `[u8]` payload of a request or response of the
+//! `<run>/work` request-response service:
+//!
+//! ```text
+//! 0..4    magic  b"MPCT"
+//! 4..8    PROTOCOL_VERSION, u32 little endian
+//! 8..12   header length H, u32 little endian
+//! 12..    bincode-2 (serde, standard config) header of H bytes
+//!         zero padding up to the next multiple of 8
+//!         raw little-endian f64 arrays, one after the other
+//! ```
+//!
+//! The arrays are never serialised per element: they are copied into the
+//! shared-memory payload with one `memcpy` each and read back zero-copy when
+//! the payload is 8-byte aligned.
+//!
+//! ```
+//! use protocol::{decode_to_worker, encode_to_vec, ToWorker, Envelope};
+//! let msg: Envelope<ToWorker<String>> = Envelope::new("run1", ToWorker::Done);
+//! let bytes = encode_to_vec(&msg, &[]).unwrap();
+//! let back = decode_to_worker::<String>(&bytes, "run1").unwrap();
+//! assert_eq!(back.header.body, ToWorker::Done);
+//! ```
+
+mod ipc;
+mod messages;
+mod wire;
+
+pub use ipc::{
+    coord_node_name, create_node, event_service_port, ipc_config, ipc_root_dir, node_alive,
+    to_coord_event, to_workers_event, work_service, work_service_port, worker_node_name,
+    EventService, IpcSetupError, WorkService, IPC_PREFIX, IPC_PREFIX_ENV, PORT_SLACK,
+};
+pub use messages::{
+    CaseAssignment, CheckFinite, Envelope, Failure, Ready, ResultHeader, ToCoord, ToWorker,
+    FIELD_NAMES,
+};
+pub use wire::{
+    decode, decode_to_coord, decode_to_worker, encode_header, encode_into, encode_to_vec,
+    frame_len, read_field, validate_result, Decoded, Expected, ProtocolError, HEADER_OFFSET, MAGIC,
+};
+
+/// The version of this protocol. Bumped on every change of a message type or
+/// of the wire layout; a message carrying another version is rejected.
+pub const PROTOCOL_VERSION: u32 = 1;
+
+#[cfg(test)]
+mod tests;

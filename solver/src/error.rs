@@ -1,0 +1,38 @@
+//! Errors of the solver crate: bad input named by field, and numerical failures.
+
+use thiserror::Error;
+
+/// Everything the solver can refuse or fail at.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SolverError {
+    /// An input value is impossible; `field` names it.
+    #[error("invalid {field}: {reason}")]
+    Invalid {
+        /// The offending input (config key or parameter name).
+        field: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The contact reaches the edge of the computational domain.
+    #[error("the contact reaches the edge of the domain ({detail}); enlarge grid.points or grid.spacing_um")]
+    DomainTooSmall {
+        /// Which zone touches the boundary.
+        detail: String,
+    },
+    /// The whole contact slides: no stick cell is left.
+    #[error("gross sliding: {detail}")]
+    GrossSliding {
+        /// Context.
+        detail: String,
+    },
+}
+
+impl SolverError {
+    /// Shorthand for [`SolverError::Invalid`].
+    pub fn invalid(field: &str, reason: impl Into<String>) -> Self {
+        SolverError::Invalid {
+            field: field.to_string(),
+            reason: reason.into(),
+        }
+    }
+}

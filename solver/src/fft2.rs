@@ -1,0 +1,140 @@
+//! Real-to-complex 2-D FFTs on the padded `M x M` grid (M = 2N) used by DC-FFT.
+//! Owns FFT plans and scratch; knows nothing about kernels or physics.
+//!
+//! Layout: real arrays are row-major `[iy][ix]` with `M` columns. Spectra are
+//! stored *transposed*, `[kx][ky]` with `M/2 + 1` rows of `M` complex values,
+//! so the column transforms run on contiguous memory. Forward transforms may
+//! assume that only the first `N` rows and columns of the input are non-zero
+//! (zero padding), and inverse transforms only produce the first `N` rows.
+
+use num_complex::Complex64;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+/// FFT plans and scratch for one padded grid size. Build once, apply many times.
+pub struct Fft2 {
+    m: usize,
+    n: usize,
+    r2c: Arc<dyn RealToComplex<f64>>,
+    c2r: Arc<dyn ComplexToReal<f64>>,
+    col_fwd: Arc<dyn Fft<f64>>,
+    col_inv: Arc<dyn Fft<f64>>,
+    row_real: Vec<f64>,
+    rows: Vec<Complex64>,
+    scratch: Vec<Complex64>,
+}
+
+impl Fft2 {
+    /// Plans for an `n x n` physical grid padded to `2n x 2n`.
+    pub fn new(n: usize) -> Self {
+        let m = 2 * n;
+        let mut rp = RealFftPlanner::<f64>::new();
+        let r2c = rp.plan_fft_forward(m);
+        let c2r = rp.plan_fft_inverse(m);
+        let mut cp = FftPlanner::<f64>::new();
+        let col_fwd = cp.plan_fft_forward(m);
+        let col_inv = cp.plan_fft_inverse(m);
+        let h = m / 2 + 1;
+        let scratch_len = [
+            r2c.get_scratch_len(),
+            c2r.get_scratch_len(),
+            col_fwd.get_inplace_scratch_len(),
+            col_inv.get_inplace_scratch_len(),
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0)
+        .max(1);
+        Fft2 {
+            m,
+            n,
+            r2c,
+            c2r,
+            col_fwd,
+            col_inv,
+            row_real: vec![0.0; m],
+            rows: vec![Complex64::default(); m * h],
+            scratch: vec![Complex64::default(); scratch_len],
+        }
+    }
+
+    /// Padded size `M = 2N`.
+    pub fn padded(&self) -> usize {
+        self.m
+    }
+
+    /// Number of complex values of a (half) spectrum.
+    pub fn spectrum_len(&self) -> usize {
+        self.m * (self.m / 2 + 1)
+    }
+
+    /// Forward transform of a full `M x M` real array (used for kernels).
+    pub fn forward_full(&mut self, input: &[f64], out: &mut [Complex64]) {
+        self.forward_rows(input, self.m, self.m, out);
+    }
+
+    /// Forward transform of an `N x N` field (row-major, `N` columns) zero-padded to `M x M`.
+    pub fn forward_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
+        self.forward_rows(input, self.n, self.n, out);
+    }
+
+    fn forward_rows(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
+        let m = self.m;
+        let h = m / 2 + 1;
+        debug_assert_eq!(input.len(), nrows * ncols);
+        debug_assert_eq!(out.len(), m * h);
+        // Row transforms of the non-zero rows into `rows` ([iy][kx], h columns).
+        for iy in 0..nrows {
+            self.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
+            self.row_real[ncols..].fill(0.0);
+            let dst = &mut self.rows[iy * h..(iy + 1) * h];
+            // Lengths are fixed by construction, so this cannot fail.
+            let _ = self
+                .r2c
+                .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
+        }
+        // Transpose into out ([kx][ky]) with zero rows for iy >= nrows.
+        for kx in 0..h {
+            let col = &mut out[kx * m..(kx + 1) * m];
+            for (iy, c) in col[..nrows].iter_mut().enumerate() {
+                *c = self.rows[iy * h + kx];
+            }
+            col[nrows..].fill(Complex64::default());
+        }
+        self.col_fwd.process_with_scratch(out, &mut self.scratch);
+    }
+
+    /// Inverse transform of a spectrum (consumed as scratch) into the first
+    /// `N x N` block of the real result, scaled by `1/M²`.
+    pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        let m = self.m;
+        let n = self.n;
+        let h = m / 2 + 1;
+        debug_assert_eq!(spec.len(), m * h);
+        debug_assert_eq!(out.len(), n * n);
+        self.col_inv.process_with_scratch(spec, &mut self.scratch);
+        let scale = 1.0 / (m as f64 * m as f64);
+        let mut row_c = std::mem::take(&mut self.rows);
+        for iy in 0..n {
+            let dst = &mut row_c[..h];
+            for (kx, d) in dst.iter_mut().enumerate() {
+                *d = spec[kx * m + iy];
+            }
+            // The imaginary parts of the DC and Nyquist bins are zero up to round-off;
+            // realfft would reject them, so clear them explicitly.
+            dst[0].im = 0.0;
+            dst[h - 1].im = 0.0;
+            let _ = self
+                .c2r
+                .process_with_scratch(dst, &mut self.row_real, &mut self.scratch);
+            for (o, r) in out[iy * n..(iy + 1) * n]
+                .iter_mut()
+                .zip(&self.row_real[..n])
+            {
+                *o = r * scale;
+            }
+        }
+        self.rows = row_c;
+    }
+}

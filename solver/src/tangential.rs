@@ -1,0 +1,341 @@
+//! Partial-slip tangential contact at fixed pressure: shear tractions `q` on the
+//! contact cells with the friction disc `|q_i| ≤ μ p_i` per cell and the total
+//! force `ΔA Σ q = F` (force control). Sees only the operator's tangential block
+//! and an extra slip term supplied by the caller (normal–tangential coupling).
+//!
+//! Method: accelerated projected gradient (FISTA with adaptive restart) on the
+//! convex problem min ½qᵀCq + eᵀq over {|q_i| ≤ μp_i} ∩ {ΔA Σq = F}. The exact
+//! Euclidean projection onto that set shifts all tractions by one 2-D
+//! multiplier λ (found by Newton's method) before clipping them to their discs;
+//! λ divided by the step is the rigid shift δt of the sphere.
+
+use crate::error::SolverError;
+use crate::operator::Operator;
+
+/// Convergence report of one tangential solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TangentialReport {
+    /// Iterations used.
+    pub iterations: usize,
+    /// Final KKT residual: max over cells of the free / reduced gradient, relative to |δt|.
+    pub change: f64,
+    /// max over stick cells of |s_i| / |δt| (slip must vanish there).
+    pub stick_residual: f64,
+    /// max over slip cells of |w_i + |w_i| e_i| / |δt|, with e_i = q_i/|q_i| and
+    /// w_i the slip: zero when the traction opposes the slip exactly.
+    pub slip_residual: f64,
+    /// |ΔA Σ q − F| / |F|.
+    pub force_error: f64,
+    /// True when the KKT residual fell below the tolerance within the budget.
+    pub converged: bool,
+}
+
+/// Solution of a tangential problem.
+#[derive(Clone, Debug)]
+pub struct TangentialSolution {
+    /// Shear tractions, Pa.
+    pub qx: Vec<f64>,
+    /// Shear tractions, Pa.
+    pub qy: Vec<f64>,
+    /// Slip of the substrate relative to the sphere, m (zero on stick cells).
+    pub sx: Vec<f64>,
+    /// Slip, m.
+    pub sy: Vec<f64>,
+    /// 1 on stick cells, 0 elsewhere.
+    pub stick: Vec<bool>,
+    /// Rigid tangential shift of the sphere δt, m.
+    pub shift: [f64; 2],
+    /// Convergence.
+    pub report: TangentialReport,
+}
+
+/// Inputs of a tangential solve.
+pub struct TangentialProblem<'a> {
+    /// Pressure (fixed), Pa.
+    pub p: &'a [f64],
+    /// Friction coefficient μ.
+    pub friction: f64,
+    /// Total tangential force (N), components x and y.
+    pub force: [f64; 2],
+    /// Extra tangential displacement added to the slip (coupling term
+    /// `ut(p) − ut(p0)`), m, x and y; `None` for no coupling.
+    pub extra: Option<(&'a [f64], &'a [f64])>,
+    /// Relative-change tolerance.
+    pub tolerance: f64,
+    /// Iteration budget.
+    pub max_iterations: usize,
+    /// Warm start (qx, qy).
+    pub q_init: Option<(&'a [f64], &'a [f64])>,
+}
+
+/// Exact projection of `z` onto { |q_i| ≤ b_i, Σ q_i = target }: q_i = Π_i(z_i + λ).
+/// Returns `None` if no λ satisfies the force (gross sliding).
+fn project(
+    (zx, zy): (&[f64], &[f64]),
+    bound: &[f64],
+    cells: &[usize],
+    target: [f64; 2],
+    lambda: &mut [f64; 2],
+    (qx, qy): (&mut [f64], &mut [f64]),
+) -> Option<()> {
+    let cap: f64 = cells.iter().map(|&i| bound[i]).sum();
+    let tnorm = target[0].hypot(target[1]);
+    if tnorm >= cap {
+        return None;
+    }
+    let tol = 1e-14 * cap;
+    let mut l = *lambda;
+    let eval = |l: [f64; 2], qx: &mut [f64], qy: &mut [f64]| {
+        let mut f = [-target[0], -target[1]];
+        let mut j = [[0.0; 2]; 2];
+        for &i in cells {
+            let (wx, wy) = (zx[i] + l[0], zy[i] + l[1]);
+            let w = wx.hypot(wy);
+            let b = bound[i];
+            if w <= b {
+                qx[i] = wx;
+                qy[i] = wy;
+                j[0][0] += 1.0;
+                j[1][1] += 1.0;
+            } else {
+                let s = b / w;
+                let (nx, ny) = (wx / w, wy / w);
+                qx[i] = s * wx;
+                qy[i] = s * wy;
+                j[0][0] += s * (1.0 - nx * nx);
+                j[0][1] -= s * nx * ny;
+                j[1][1] += s * (1.0 - ny * ny);
+            }
+            f[0] += qx[i];
+            f[1] += qy[i];
+        }
+        j[1][0] = j[0][1];
+        (f, j)
+    };
+    let (mut f, mut j) = eval(l, qx, qy);
+    for _ in 0..200 {
+        let fn_ = f[0].hypot(f[1]);
+        if fn_ <= tol {
+            *lambda = l;
+            return Some(());
+        }
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        let (mut dx, mut dy) = if det.abs() > 1e-300 {
+            (
+                -(j[1][1] * f[0] - j[0][1] * f[1]) / det,
+                -(-j[1][0] * f[0] + j[0][0] * f[1]) / det,
+            )
+        } else {
+            (-f[0] / cells.len() as f64, -f[1] / cells.len() as f64)
+        };
+        // Backtracking on |f| (f is the gradient of a convex function of λ).
+        let mut accepted = false;
+        for _ in 0..60 {
+            let trial = [l[0] + dx, l[1] + dy];
+            let (ft, jt) = eval(trial, qx, qy);
+            if ft[0].hypot(ft[1]) < fn_ {
+                l = trial;
+                f = ft;
+                j = jt;
+                accepted = true;
+                break;
+            }
+            dx *= 0.5;
+            dy *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    // Final evaluation at the best λ; accept a tiny residual.
+    let (f, _) = eval(l, qx, qy);
+    *lambda = l;
+    if f[0].hypot(f[1]) <= 1e-10 * cap.max(tnorm) {
+        Some(())
+    } else {
+        None
+    }
+}
+
+/// Solves the force-controlled partial-slip problem at fixed pressure.
+pub fn solve_tangential(
+    op: &mut Operator,
+    prob: &TangentialProblem,
+) -> Result<TangentialSolution, SolverError> {
+    let grid = op.grid();
+    let len = grid.len();
+    let da = grid.cell_area();
+    let p = prob.p;
+    let mu = prob.friction;
+    let cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
+    let bound: Vec<f64> = p.iter().map(|&v| mu * v.max(0.0)).collect();
+    let normal: f64 = p.iter().sum::<f64>() * da;
+    let fnorm = prob.force[0].hypot(prob.force[1]);
+    if fnorm >= mu * normal {
+        return Err(SolverError::GrossSliding {
+            detail: format!(
+                "tangential force {fnorm:.6e} N reaches the friction limit μP = {:.6e} N",
+                mu * normal
+            ),
+        });
+    }
+    let target = [prob.force[0] / da, prob.force[1] / da];
+    let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
+    let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
+    match prob.q_init {
+        Some((ix, iy)) => {
+            zx.copy_from_slice(ix);
+            zy.copy_from_slice(iy);
+        }
+        None => {
+            for &i in &cells {
+                zx[i] = prob.force[0] / normal * p[i];
+                zy[i] = prob.force[1] / normal * p[i];
+            }
+        }
+    }
+    for i in 0..len {
+        if p[i] <= 0.0 {
+            zx[i] = 0.0;
+            zy[i] = 0.0;
+        }
+    }
+    let mut lambda = [0.0; 2];
+    let gross = || SolverError::GrossSliding {
+        detail: "no traction field satisfies both the friction discs and the force".into(),
+    };
+    project(
+        (&zx, &zy),
+        &bound,
+        &cells,
+        target,
+        &mut lambda,
+        (&mut qx, &mut qy),
+    )
+    .ok_or_else(gross)?;
+
+    let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
+    let (mut yx, mut yy) = (qx.clone(), qy.clone());
+    let (mut px, mut py) = (vec![0.0; len], vec![0.0; len]);
+    let mut stick = vec![false; len];
+    let mut report = TangentialReport::default();
+    let stick_tol = 1.0 - 1e-9;
+    // Step 1/L, L the largest eigenvalue of the tangential block.
+    let step = 1.0 / op.tangential_bound();
+
+    let slip_field = |op: &mut Operator, qx: &[f64], qy: &[f64], sx: &mut [f64], sy: &mut [f64]| {
+        op.tangential(qx, qy, sx, sy);
+        if let Some((ex, ey)) = prob.extra {
+            for i in 0..sx.len() {
+                sx[i] += ex[i];
+                sy[i] += ey[i];
+            }
+        }
+    };
+
+    // Accelerated projected gradient (FISTA) with gradient-based adaptive restart
+    // (O'Donoghue & Candès 2015) on min ½qᵀCq + eᵀq over {discs} ∩ {force}.
+    // The projection's multiplier λ is the rigid shift: δt = λ / step.
+    let mut t_k = 1.0_f64;
+    for it in 1..=prob.max_iterations {
+        report.iterations = it;
+        slip_field(op, &yx, &yy, &mut sx, &mut sy);
+        for &i in &cells {
+            zx[i] = yx[i] - step * sx[i];
+            zy[i] = yy[i] - step * sy[i];
+        }
+        project(
+            (&zx, &zy),
+            &bound,
+            &cells,
+            target,
+            &mut lambda,
+            (&mut px, &mut py),
+        )
+        .ok_or_else(gross)?;
+        // Gradient mapping residual, relative to the rigid shift.
+        let shift_norm = (lambda[0].hypot(lambda[1]) / step).max(f64::MIN_POSITIVE);
+        let (mut res, mut restart_dot) = (0.0_f64, 0.0);
+        for &i in &cells {
+            let (dx, dy) = (yx[i] - px[i], yy[i] - py[i]);
+            res = res.max(dx.hypot(dy));
+            restart_dot += dx * (px[i] - qx[i]) + dy * (py[i] - qy[i]);
+        }
+        report.change = res / step / shift_norm;
+        let t_next = if restart_dot > 0.0 {
+            1.0
+        } else {
+            0.5 * (1.0 + (1.0 + 4.0 * t_k * t_k).sqrt())
+        };
+        let mom = if restart_dot > 0.0 {
+            0.0
+        } else {
+            (t_k - 1.0) / t_next
+        };
+        t_k = t_next;
+        for &i in &cells {
+            let (ox, oy) = (qx[i], qy[i]);
+            qx[i] = px[i];
+            qy[i] = py[i];
+            yx[i] = px[i] + mom * (px[i] - ox);
+            yy[i] = py[i] + mom * (py[i] - oy);
+        }
+        if report.change < prob.tolerance {
+            report.converged = true;
+            break;
+        }
+    }
+    let mut shift = [lambda[0] / step, lambda[1] / step];
+
+    // Final slip, stick set, shift and KKT residuals of the returned tractions.
+    slip_field(op, &qx, &qy, &mut sx, &mut sy);
+    let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
+    for &i in &cells {
+        stick[i] = qx[i].hypot(qy[i]) < stick_tol * bound[i];
+        if stick[i] {
+            mx += sx[i];
+            my += sy[i];
+            nst += 1;
+        }
+    }
+    if nst > 0 {
+        shift = [mx / nst as f64, my / nst as f64];
+    }
+    let scale = shift[0].hypot(shift[1]).max(f64::MIN_POSITIVE);
+    let (mut st_res, mut sl_res) = (0.0_f64, 0.0_f64);
+    let (mut fx, mut fy) = (0.0, 0.0);
+    for i in 0..len {
+        fx += qx[i];
+        fy += qy[i];
+        if p[i] <= 0.0 {
+            sx[i] = 0.0;
+            sy[i] = 0.0;
+            continue;
+        }
+        let (wx, wy) = (sx[i] - shift[0], sy[i] - shift[1]);
+        if stick[i] {
+            st_res = st_res.max(wx.hypot(wy) / scale);
+            sx[i] = 0.0;
+            sy[i] = 0.0;
+        } else {
+            let qn = qx[i].hypot(qy[i]);
+            let w = wx.hypot(wy);
+            sl_res = sl_res.max((wx + w * qx[i] / qn).hypot(wy + w * qy[i] / qn) / scale);
+            sx[i] = wx;
+            sy[i] = wy;
+        }
+    }
+    report.stick_residual = st_res;
+    report.slip_residual = sl_res;
+    report.force_error =
+        (fx * da - prob.force[0]).hypot(fy * da - prob.force[1]) / fnorm.max(f64::MIN_POSITIVE);
+    Ok(TangentialSolution {
+        qx,
+        qy,
+        sx,
+        sy,
+        stick,
+        shift,
+        report,
+    })
+}

@@ -1,0 +1,117 @@
+//! Validation ladder steps 3–5 and 8 (PHYSICS.md §8): Hertz, Cattaneo–Mindlin,
+//! flat isotropic μa = μ, and equilibrium, on the paper's Table 1a case.
+
+mod common;
+
+use common::table_1a_fe;
+use solver::case::{solve_case, KernelCache};
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a / b - 1.0).abs()
+}
+
+#[test]
+fn hertz_table_1a_radius_peak_and_approach_within_1pct() {
+    let spec = table_1a_fe(512, 0.5, false, 0.0);
+    let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
+    let s = &out.scalars;
+    let e_star: f64 = 210.0e9 / (1.0 - 0.09);
+    let a = (3.0 * 20.0 * 18.0e-3 / (4.0 * e_star)).cbrt();
+    let p_h = 3.0 * 20.0 / (2.0 * std::f64::consts::PI * a * a);
+    println!(
+        "a = {:.6e} (Hertz {a:.6e}), p_max = {:.6e} (Hertz {p_h:.6e}), δz = {:.6e} (a²/R {:.6e}), iterations {}",
+        s.contact_radius_m,
+        s.p_max_pa,
+        s.delta_z_m,
+        a * a / 18.0e-3,
+        s.normal_iterations
+    );
+    assert!(s.converged, "{:?}", s.normal);
+    assert!((a / 0.1054e-3 - 1.0).abs() < 0.01, "paper's a");
+    assert!(rel(s.contact_radius_m, a) < 0.01, "contact radius");
+    assert!(rel(s.p_max_pa, p_h) < 0.01, "peak pressure");
+    assert!(rel(s.p_max_pa, 860.0e6) < 0.01, "paper's p_H");
+    assert!(rel(s.delta_z_m, a * a / 18.0e-3) < 0.01, "approach");
+    assert!(rel(s.normal_force_n, 20.0) < 1e-8, "Σ p ΔA = P");
+}
+
+/// Cattaneo–Mindlin closed forms for Table 1a with the Hertz radius `a`.
+struct Mindlin {
+    a: f64,
+    c: f64,
+    delta: f64,
+}
+
+fn mindlin() -> Mindlin {
+    let (e, nu, p, r, mu, ratio): (f64, f64, f64, f64, f64, f64) =
+        (210.0e9, 0.3, 20.0, 18.0e-3, 0.28571, 0.6);
+    let a = (3.0 * p * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
+    let c = a * (1.0 - ratio).cbrt();
+    let delta0 = 3.0 * mu * p * (2.0 - nu) * (1.0 + nu) / (8.0 * a * e);
+    Mindlin {
+        a,
+        c,
+        delta: delta0 * (1.0 - (1.0 - ratio).powf(2.0 / 3.0)),
+    }
+}
+
+#[test]
+fn cattaneo_mindlin_uncoupled_then_coupled_on_table_1a() {
+    let mut cache = KernelCache::new();
+    let m = mindlin();
+    let f = 0.6 * 0.28571 * 20.0;
+
+    // Coupling off: Cattaneo–Mindlin exactly.
+    let spec = table_1a_fe(512, 0.5, false, 0.6);
+    let off = solve_case(&spec, &mut cache).unwrap().scalars;
+    println!(
+        "uncoupled: c = {:.6e} (Mindlin {:.6e}), c/a = {:.5}, δx = {:.6e} (Mindlin {:.6e}), μa = {:?}, iterations n/t {} {}, {:?}",
+        off.stick_radius_m,
+        m.c,
+        off.stick_radius_m / off.contact_radius_m,
+        off.delta_t_m,
+        m.delta,
+        off.mu_a,
+        off.normal_iterations,
+        off.tangential_iterations,
+        off.tangential
+    );
+    assert!(off.converged);
+    assert!(rel(off.contact_radius_m, m.a) < 0.01, "contact radius");
+    assert!(rel(off.stick_radius_m, m.c) < 0.02, "stick radius");
+    assert!(rel(off.delta_t_m, m.delta) < 0.01, "tangential shift");
+    assert!(rel(off.tangential_force_n[0], f) < 1e-8, "Σ q ΔA = F");
+    assert!(off.tangential_force_n[1].abs() < 1e-8 * f);
+    assert!(rel(off.normal_force_n, 20.0) < 1e-8, "Σ p ΔA = P");
+    assert!(rel(off.mu_a.unwrap(), 0.28571) < 0.01, "μa = μ");
+    // KKT residuals of the returned tractions are within the requested tolerance.
+    let ttol = spec.tangential_tolerance;
+    assert!(
+        off.tangential.stick_residual < 2.0 * ttol && off.tangential.slip_residual < 2.0 * ttol
+    );
+
+    // Coupling on: converges, equilibrium holds, μa close to μ.
+    let spec = table_1a_fe(512, 0.5, true, 0.6);
+    let on = solve_case(&spec, &mut cache).unwrap().scalars;
+    println!(
+        "coupled: c/a = {:.5}, δx = {:.6e}, μa = {:?}, p_max {:.6e} ({:+.3}% vs uncoupled), stick area {:+.3}%, δt⊥ = {:.3e}, iterations n/t/c {} {} {}",
+        on.stick_radius_m / on.contact_radius_m,
+        on.delta_t_m,
+        on.mu_a,
+        on.p_max_pa,
+        100.0 * (on.p_max_pa / off.p_max_pa - 1.0),
+        100.0 * (on.stick_area_m2 / off.stick_area_m2 - 1.0),
+        on.delta_t_perp_m,
+        on.normal_iterations,
+        on.tangential_iterations,
+        on.coupling_iterations
+    );
+    assert!(on.converged);
+    assert!(
+        rel(on.tangential_force_n[0], f) < 1e-8,
+        "Σ q ΔA = F (coupled)"
+    );
+    assert!(rel(on.normal_force_n, 20.0) < 1e-8, "Σ p ΔA = P (coupled)");
+    assert!(rel(on.mu_a.unwrap(), 0.28571) < 0.03, "μa ≈ μ (coupled)");
+    assert!(cache.builds() == 1, "one kernel for both cases");
+}

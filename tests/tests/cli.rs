@@ -1,0 +1,174 @@
+//! End-to-end tests of the `mpcontact` binary's single-process commands:
+//! `solve` outputs, clear errors for bad input (never a panic), `kernel` JSON.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// The `mpcontact` binary of the same build. `cargo test --workspace` builds it
+/// (the coordinator's own integration tests need it).
+fn exe() -> PathBuf {
+    let mut p = std::env::current_exe().unwrap();
+    p.pop();
+    if p.ends_with("deps") {
+        p.pop();
+    }
+    let exe = p.join("mpcontact");
+    assert!(
+        exe.exists(),
+        "{} not built: run `cargo test --workspace`",
+        exe.display()
+    );
+    exe
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(exe())
+        .args(args)
+        .output()
+        .expect("run mpcontact")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mpcontact-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SMALL: &str = r#"
+[grid]
+points = 64
+spacing_um = 4.0
+
+[indenter]
+radius_mm = 18.0
+
+[load]
+normal_n = 20.0
+friction = 0.28571
+tangential_ratio = 0.6
+
+[sweep]
+materials = ["Fe"]
+surfaces = ["flat"]
+angles_deg = [30.0]
+"#;
+
+#[test]
+fn solve_writes_case_json_and_nine_npy_fields() {
+    let dir = temp_dir("solve");
+    std::fs::write(dir.join("c.toml"), SMALL).unwrap();
+    let out = run(&[
+        "solve",
+        dir.join("c.toml").to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("o/case.json")).unwrap()).unwrap();
+    for key in [
+        "contact_radius_m",
+        "stick_radius_m",
+        "delta_t_m",
+        "delta_z_m",
+        "p_max_pa",
+        "contact_area_m2",
+        "stick_area_m2",
+        "mu_a",
+        "converged",
+        "normal_iterations",
+        "tangential_iterations",
+        "coupling_iterations",
+    ] {
+        assert!(json.get(key).is_some(), "case.json lacks {key}");
+    }
+    assert_eq!(json["angle_deg"], 30.0);
+    // Equilibrium as written: the tangential force points at 30°.
+    let f = json["tangential_force_n"].as_array().unwrap();
+    let (fx, fy) = (f[0].as_f64().unwrap(), f[1].as_f64().unwrap());
+    assert!((fy.atan2(fx).to_degrees() - 30.0).abs() < 1e-6);
+    for name in ["p", "qx", "qy", "sx", "sy", "stick", "ux", "uy", "uz"] {
+        let bytes = std::fs::read(dir.join(format!("o/{name}.npy"))).unwrap();
+        let header = String::from_utf8_lossy(&bytes[..128.min(bytes.len())]).to_string();
+        assert!(
+            header.contains("(64, 64") && header.contains("<f8"),
+            "{name}: {header}"
+        );
+        assert!(bytes.len() >= 64 * 64 * 8);
+    }
+}
+
+fn expect_error(config: &str, sets: &[&str], needle: &str) {
+    let dir = temp_dir(&format!("bad{}", needle.len()));
+    std::fs::write(dir.join("c.toml"), config).unwrap();
+    let mut args = vec![
+        "solve".to_string(),
+        dir.join("c.toml").display().to_string(),
+        "--out".into(),
+        dir.join("o").display().to_string(),
+    ];
+    for s in sets {
+        args.push("--set".into());
+        args.push(s.to_string());
+    }
+    let out = Command::new(exe()).args(&args).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{sets:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "{sets:?}: expected `{needle}` in: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn bad_input_is_a_clear_error_not_a_panic() {
+    expect_error(SMALL, &["load.tangential_ratio=1.2"], "gross sliding");
+    expect_error(SMALL, &["load.normal_n=0"], "load.normal_n");
+    expect_error(SMALL, &["grid.spacing_um=-1"], "grid.spacing_um");
+    expect_error(SMALL, &["load.friction=nan"], "load.friction");
+    // 64 cells of 0.5 µm cannot hold a 105 µm contact.
+    expect_error(SMALL, &["grid.spacing_um=0.5"], "edge of the domain");
+    expect_error(
+        &SMALL.replace("friction = 0.28571", "friction = 0.28571\nfrction = 1"),
+        &[],
+        "frction",
+    );
+}
+
+#[test]
+fn kernel_prints_h_theta_matching_the_isotropic_closed_form() {
+    let out = run(&["kernel", "--material", "Cu", "--angles-deg", "0:90:45"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v.as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    let (e, nu) = (128.73e9, 0.345);
+    let g = e / (2.0 * (1.0 + nu));
+    for row in rows {
+        let th = row["theta_deg"].as_f64().unwrap().to_radians();
+        let h33 = row["H_re"][2][2].as_f64().unwrap();
+        let h13_im = row["H_im"][0][2].as_f64().unwrap();
+        assert!((h33 * g / (1.0 - nu) - 1.0).abs() < 1e-9);
+        let want = -(1.0 - 2.0 * nu) * th.cos() / (2.0 * g);
+        assert!((h13_im - want).abs() < 1e-9 * (1.0 / g));
+    }
+}
+
+#[test]
+fn materials_lists_the_six_presets() {
+    let out = run(&["materials"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for m in ["Fe ", "Cu ", "Ni ", "Fe(111)", "Cu(111)", "Ni(111)"] {
+        assert!(text.contains(m), "{m}");
+    }
+}

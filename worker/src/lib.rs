@@ -1,0 +1,432 @@
+//! # mpcontact worker
+//!
+//! The worker process of a sweep: attaches to a run as a client of the
+//! `<run>/work` pull queue, announces itself, solves the cases it is sent
+//! with operators kept resident per (material, grid), and returns scalars
+//! (and fields when asked) in shared memory. A thin shell around
+//! [`solver::case::solve_case`]; all names and the wire format come from
+//! `protocol`.
+//!
+//! It exits cleanly when the coordinator answers `Done`, and on its own when
+//! the coordinator's node disappears (checked on every timed-wait timeout).
+
+use std::collections::HashSet;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use anyhow::{anyhow, bail, Context};
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::client::Client;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::*;
+use protocol::{
+    CaseAssignment, CheckFinite, Envelope, Failure, Ready, ResultHeader, ToCoord, ToWorker,
+    FIELD_NAMES,
+};
+use serde::{Deserialize, Serialize};
+use solver::case::{solve_case, CaseScalars, CaseSpec, KernelCache};
+
+/// Case specification as it travels on the wire.
+pub type WireSpec = CaseSpec;
+
+/// Result scalars as they travel on the wire: the solver's scalars, checked
+/// for NaN/∞ in the values a results row reports.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct WireScalars(pub CaseScalars);
+
+impl CheckFinite for WireScalars {
+    fn first_non_finite(&self) -> Option<String> {
+        let s = &self.0;
+        let named = [
+            ("contact_radius_m", s.contact_radius_m),
+            ("stick_radius_m", s.stick_radius_m),
+            ("delta_t_m", s.delta_t_m),
+            ("delta_z_m", s.delta_z_m),
+            ("p_max_pa", s.p_max_pa),
+            ("contact_area_m2", s.contact_area_m2),
+            ("stick_area_m2", s.stick_area_m2),
+            ("k_e", s.k_e),
+            ("mu_a", s.mu_a.unwrap_or(0.0)),
+        ];
+        named
+            .iter()
+            .find(|(_, v)| !v.is_finite())
+            .map(|(k, _)| k.to_string())
+    }
+}
+
+/// Coordinator → worker message of this build.
+pub type CoordMessage = ToWorker<WireSpec>;
+/// Worker → coordinator message of this build.
+pub type WorkerMessage = ToCoord<WireScalars>;
+
+/// How long a worker waits for the work service to appear at start.
+const ATTACH_TIMEOUT: Duration = Duration::from_secs(20);
+/// Timed-wait period; on each timeout the coordinator's liveness is checked.
+const WAIT_PERIOD: Duration = Duration::from_millis(500);
+
+type WorkClient = Client<ipc::Service, [u8], (), [u8], ()>;
+type Pending = PendingResponse<ipc::Service, [u8], (), [u8], ()>;
+
+/// Everything a worker holds while attached to a run.
+struct Attached {
+    run_id: String,
+    cfg: Config,
+    index: usize,
+    node: Node<ipc::Service>,
+    client: WorkClient,
+    notifier: Notifier<ipc::Service>,
+    listener: Listener<ipc::Service>,
+}
+
+/// How a wait for the coordinator's answer ended.
+enum Answer {
+    Message(Box<CoordMessage>),
+    CoordinatorGone,
+}
+
+/// Attach to run `run_id` as worker `worker_index`, solve cases until the
+/// coordinator says `Done` (or disappears), then detach. Returns an error
+/// only when attaching fails or the coordinator rejects this worker.
+pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
+    let w = attach(run_id, worker_index)?;
+    let mut cache = KernelCache::new();
+    let mut keys: HashSet<String> = HashSet::new();
+    let mut next: WorkerMessage = ToCoord::Ready(Ready {
+        worker_index: worker_index as u32,
+        pid: std::process::id(),
+    });
+    let mut fields_buf: Option<solver::case::Fields> = None;
+    loop {
+        let pending = w.send(&next, fields_buf.as_ref())?;
+        let answer = match w.wait_answer(&pending)? {
+            Answer::Message(m) => Some(*m),
+            Answer::CoordinatorGone => None,
+        };
+        match answer {
+            None => {
+                eprintln!("worker {worker_index}: coordinator of run {run_id} is gone; exiting");
+                return Ok(());
+            }
+            Some(ToWorker::Done) => return Ok(()),
+            Some(ToWorker::Rejected { reason }) => {
+                bail!("worker {worker_index}: rejected by the coordinator: {reason}")
+            }
+            Some(ToWorker::Case(case)) => {
+                drop(pending);
+                let (msg, fields) = solve_one(&case, worker_index, &mut cache, &mut keys);
+                next = msg;
+                fields_buf = fields;
+            }
+        }
+    }
+}
+
+fn solve_one(
+    case: &CaseAssignment<WireSpec>,
+    worker_index: usize,
+    cache: &mut KernelCache,
+    keys: &mut HashSet<String>,
+) -> (WorkerMessage, Option<solver::case::Fields>) {
+    let start = Instant::now();
+    keys.insert(case.spec.kernel_key());
+    let solved = solve_case(&case.spec, cache);
+    let solve_seconds = start.elapsed().as_secs_f64();
+    match solved {
+        Ok(out) => {
+            let want = case.want_fields;
+            let header = ResultHeader {
+                case_id: case.case_id.clone(),
+                worker_index: worker_index as u32,
+                grid_n: case.grid_n,
+                solve_seconds,
+                kernel_builds: cache.builds() as u64,
+                kernels_resident: keys.len() as u64,
+                sent_unix_ns: 0,
+                field_names: if want {
+                    FIELD_NAMES.iter().map(|s| s.to_string()).collect()
+                } else {
+                    Vec::new()
+                },
+                scalars: WireScalars(out.scalars),
+            };
+            (ToCoord::Result(header), want.then_some(out.fields))
+        }
+        Err(e) => (
+            ToCoord::Failed(Failure {
+                case_id: case.case_id.clone(),
+                worker_index: worker_index as u32,
+                error: e.to_string(),
+                solve_seconds,
+                kernel_builds: cache.builds() as u64,
+            }),
+            None,
+        ),
+    }
+}
+
+fn unix_ns() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_nanos() as u64)
+        .unwrap_or(0)
+}
+
+fn attach(run_id: &str, index: usize) -> anyhow::Result<Attached> {
+    let cfg = protocol::ipc_config()?;
+    let node = protocol::create_node(
+        &cfg,
+        &protocol::worker_node_name(run_id, index),
+        SignalHandlingMode::Disabled,
+    )?;
+    let deadline = Instant::now() + ATTACH_TIMEOUT;
+    let service = loop {
+        match protocol::work_service_port(&node, run_id, 0, false) {
+            Ok(s) => break s,
+            Err(e) if Instant::now() > deadline => {
+                return Err(anyhow!(e)).context(format!("attaching to run {run_id}"))
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(50)),
+        }
+    };
+    let client = service
+        .client_builder()
+        .initial_max_slice_len(4096)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(|e| anyhow!("cannot create the work client: {e:?}"))?;
+    let notifier =
+        protocol::event_service_port(&node, &protocol::to_coord_event(run_id), 0, false)?
+            .notifier_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create notifier: {e:?}"))?;
+    let listener =
+        protocol::event_service_port(&node, &protocol::to_workers_event(run_id), 0, false)?
+            .listener_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create listener: {e:?}"))?;
+    Ok(Attached {
+        run_id: run_id.to_string(),
+        cfg,
+        index,
+        node,
+        client,
+        notifier,
+        listener,
+    })
+}
+
+impl Attached {
+    /// Encode `msg` (and `fields` after its header) straight into a loaned
+    /// request, send it and wake the coordinator.
+    fn send(
+        &self,
+        msg: &WorkerMessage,
+        fields: Option<&solver::case::Fields>,
+    ) -> anyhow::Result<Pending> {
+        let mut msg = msg.clone();
+        if let ToCoord::Result(h) = &mut msg {
+            h.sent_unix_ns = unix_ns();
+        }
+        let env = Envelope::new(&self.run_id, msg);
+        let header = protocol::encode_header(&env)?;
+        let arrays: Vec<&[f64]> = match fields {
+            Some(f) => f.named().iter().map(|(_, v)| v.as_slice()).collect(),
+            None => Vec::new(),
+        };
+        let values: usize = arrays.iter().map(|a| a.len()).sum();
+        let len = protocol::frame_len(header.len(), values);
+        let deadline = Instant::now() + ATTACH_TIMEOUT;
+        let pending = loop {
+            let mut request = self
+                .client
+                .loan_slice(len)
+                .map_err(|e| anyhow!("cannot loan a request of {len} bytes: {e:?}"))?;
+            protocol::encode_into(request.payload_mut(), &header, &arrays)?;
+            let pending = request
+                .send()
+                .map_err(|e| anyhow!("cannot send request: {e:?}"))?;
+            // Not delivered (no server connected yet, or it is gone): retry
+            // for a while, then give up.
+            if pending.number_of_server_connections() > 0 {
+                break pending;
+            }
+            if Instant::now() > deadline {
+                bail!(
+                    "worker {}: no coordinator is serving run {}",
+                    self.index,
+                    self.run_id
+                );
+            }
+            drop(pending);
+            std::thread::sleep(Duration::from_millis(50));
+        };
+        self.notifier
+            .notify()
+            .map_err(|e| anyhow!("cannot notify the coordinator: {e:?}"))?;
+        Ok(pending)
+    }
+
+    /// Wait for the coordinator's answer to `pending`, checking on every
+    /// timeout that the coordinator is still there.
+    fn wait_answer(&self, pending: &Pending) -> anyhow::Result<Answer> {
+        loop {
+            if let Some(response) = pending
+                .receive()
+                .map_err(|e| anyhow!("cannot receive response: {e:?}"))?
+            {
+                let decoded =
+                    protocol::decode_to_worker::<WireSpec>(response.payload(), &self.run_id)
+                        .context("malformed message from the coordinator")?;
+                return Ok(Answer::Message(Box::new(decoded.header.body)));
+            }
+            let woke = self
+                .listener
+                .timed_wait(|_| {}, WAIT_PERIOD)
+                .map_err(|e| anyhow!("waiting for the coordinator failed: {e:?}"))?;
+            if woke == 0 && !self.coordinator_alive(pending) {
+                return Ok(Answer::CoordinatorGone);
+            }
+        }
+    }
+
+    fn coordinator_alive(&self, pending: &Pending) -> bool {
+        self.node.try_cleanup_dead_nodes();
+        if !pending.is_connected() {
+            return false;
+        }
+        let name = protocol::coord_node_name(&self.run_id);
+        !matches!(
+            protocol::node_alive(&self.cfg, &name),
+            Ok(None | Some(false))
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use solver::material::Material;
+    use solver::surface::Surface;
+
+    fn spec(material: &str, youngs: f64, angle: f64) -> CaseSpec {
+        CaseSpec {
+            material: Material::isotropic(material, youngs, 0.3).unwrap(),
+            surface: Surface::Flat,
+            grid_points: 16,
+            spacing_m: 400e-6,
+            indenter_radius_m: 0.2,
+            normal_force_n: 6000.0,
+            friction: 0.3,
+            tangential_ratio: 0.0,
+            angle_deg: angle,
+            coupling: false,
+            tolerance: 1e-8,
+            tangential_tolerance: 1e-6,
+            max_iterations: 2000,
+            coupling_tolerance: 1e-6,
+            max_coupling_iterations: 5,
+        }
+    }
+
+    fn assignment(id: &str, spec: CaseSpec, want_fields: bool) -> CaseAssignment<WireSpec> {
+        CaseAssignment {
+            case_id: id.into(),
+            grid_n: spec.grid_points as u32,
+            want_fields,
+            attempt: 0,
+            spec,
+        }
+    }
+
+    #[test]
+    fn kernel_built_once_per_material_and_grid() {
+        let mut cache = KernelCache::new();
+        let mut keys = HashSet::new();
+        let mut builds = Vec::new();
+        for (id, s) in [
+            ("A/flat/000.0", spec("A", 130e9, 0.0)),
+            ("A/flat/045.0", spec("A", 130e9, 45.0)),
+            ("B/flat/000.0", spec("B", 200e9, 0.0)),
+            ("A/flat/090.0", spec("A", 130e9, 90.0)),
+        ] {
+            let (msg, fields) = solve_one(&assignment(id, s, false), 3, &mut cache, &mut keys);
+            assert!(fields.is_none());
+            match msg {
+                ToCoord::Result(h) => {
+                    assert_eq!(h.worker_index, 3);
+                    assert!(h.field_names.is_empty());
+                    builds.push((h.kernel_builds, h.kernels_resident));
+                }
+                other => panic!("{id}: {other:?}"),
+            }
+        }
+        assert_eq!(builds, vec![(1, 1), (1, 1), (2, 2), (2, 2)]);
+    }
+
+    #[test]
+    fn result_carries_all_fields_of_the_grid_when_asked() {
+        let mut cache = KernelCache::new();
+        let mut keys = HashSet::new();
+        let s = spec("A", 130e9, 0.0);
+        let (msg, fields) = solve_one(
+            &assignment("A/flat/000.0", s, true),
+            0,
+            &mut cache,
+            &mut keys,
+        );
+        let ToCoord::Result(h) = msg else {
+            panic!("not a result")
+        };
+        assert_eq!(h.field_names.len(), FIELD_NAMES.len());
+        let f = fields.unwrap();
+        for (_, v) in f.named() {
+            assert_eq!(v.len(), 16 * 16);
+        }
+        // The encoded message passes the coordinator's validation.
+        let arrays: Vec<&[f64]> = f.named().iter().map(|(_, v)| v.as_slice()).collect();
+        let bytes =
+            protocol::encode_to_vec(&Envelope::new("r", ToCoord::Result(h)), &arrays).unwrap();
+        let d = protocol::decode_to_coord::<WireScalars>(&bytes, "r").unwrap();
+        let ToCoord::Result(h) = &d.header.body else {
+            panic!("not a result")
+        };
+        protocol::validate_result(h, d.field_bytes, |_| {
+            Some(protocol::Expected {
+                grid_n: 16,
+                want_fields: true,
+            })
+        })
+        .unwrap();
+        assert_eq!(d.field(0, 256).unwrap().as_ref(), f.p.as_slice());
+    }
+
+    #[test]
+    fn solver_refusal_becomes_a_failure_message() {
+        let mut cache = KernelCache::new();
+        let mut keys = HashSet::new();
+        let mut s = spec("A", 130e9, 0.0);
+        s.tangential_ratio = 1.5;
+        let (msg, _) = solve_one(
+            &assignment("A/flat/000.0", s, false),
+            0,
+            &mut cache,
+            &mut keys,
+        );
+        match msg {
+            ToCoord::Failed(f) => assert!(f.error.contains("tangential_ratio"), "{}", f.error),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn non_finite_scalars_are_named() {
+        let mut s = WireScalars::default();
+        assert_eq!(s.first_non_finite(), None);
+        s.0.mu_a = Some(f64::NAN);
+        assert_eq!(s.first_non_finite().as_deref(), Some("mu_a"));
+        s.0.contact_radius_m = f64::INFINITY;
+        assert_eq!(s.first_non_finite().as_deref(), Some("contact_radius_m"));
+    }
+}
