@@ -5,5 +5,6 @@
 //! the files they write. Physics lives in `solver`; messages in `protocol`.
 
 pub mod config;
+pub mod maps;
 pub mod run;
 pub mod solve;

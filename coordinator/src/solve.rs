@@ -1,13 +1,11 @@
 //! `mpcontact solve`: one case in-process (no IPC), for inspection — writes
-//! `case.json` and the fields as `.npy`. Also the `.npy` writer shared with `run`.
+//! `case.json`, the fields as `.npy` and their PNG maps. Also the `.npy` writer shared with `run`.
 
 use crate::config::Config;
 use anyhow::{anyhow, Context, Result};
 use npyz::WriterBuilder;
 use serde::Serialize;
-use solver::case::{
-    calibrate_k_e, mu_apparent, solve_case, CaseScalars, CaseSpec, Fields, KernelCache,
-};
+use solver::case::{calibrate_k_e, mu_apparent, solve_case, CaseScalars, CaseSpec, Fields};
 use solver::material::Elasticity;
 use solver::surface::Surface;
 use std::io::BufWriter;
@@ -73,7 +71,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     };
     let spec = config.spec(material, surface, angle)?;
     spec.validate().map_err(|e| anyhow!("{e}"))?;
-    let mut cache = KernelCache::new();
+    let mut cache = worker::kernel_store::FileStore::cache();
     let out =
         solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
     let mut scalars = out.scalars;
@@ -113,5 +111,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     std::fs::write(&path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
     write_fields(args.out, &out.fields)?;
+    let title = format!("{material}, {surface}, ψ = {angle}°");
+    crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.spacing_m)?;
     Ok(scalars)
 }

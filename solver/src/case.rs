@@ -5,7 +5,7 @@
 
 use crate::error::SolverError;
 use crate::geometry::{equivalent_radius, hull_area};
-use crate::influence::{isotropic_cell, Block};
+use crate::influence::isotropic_cell;
 use crate::material::{Elasticity, Material};
 use crate::normal::{solve_normal, NormalReport};
 use crate::operator::{Grid, Operator, X, Y, Z};
@@ -206,11 +206,23 @@ impl CaseSpec {
     }
 }
 
+/// Persistent storage of real-space kernel tables (e.g. files), so that a new
+/// process does not pay an expensive anisotropic kernel build again.
+pub trait KernelStore {
+    /// The nine tables stored under `key`, if present and of `len` values each.
+    fn load(&self, key: &str, len: usize) -> Option<Vec<Vec<f64>>>;
+    /// Stores the tables under `key` (best effort).
+    fn save(&self, key: &str, tables: &[Vec<f64>]);
+}
+
 /// Resident operators, keyed by [`CaseSpec::kernel_key`].
 #[derive(Default)]
 pub struct KernelCache {
     ops: HashMap<String, Operator>,
     builds: usize,
+    loads: usize,
+    seconds: f64,
+    store: Option<Box<dyn KernelStore>>,
 }
 
 impl KernelCache {
@@ -219,39 +231,80 @@ impl KernelCache {
         Self::default()
     }
 
-    /// Number of operators built so far.
-    pub fn builds(&self) -> usize {
-        self.builds
+    /// An empty cache backed by a persistent store for anisotropic kernels.
+    pub fn with_store(store: Box<dyn KernelStore>) -> Self {
+        KernelCache {
+            store: Some(store),
+            ..Self::default()
+        }
     }
 
-    /// The operator for `spec`, built on first use.
-    pub fn operator(&mut self, spec: &CaseSpec) -> Result<&mut Operator, SolverError> {
+    /// Number of operators made resident so far (built or loaded).
+    pub fn builds(&self) -> usize {
+        self.builds + self.loads
+    }
+
+    /// Of those, how many came from the persistent store.
+    pub fn loads(&self) -> usize {
+        self.loads
+    }
+
+    /// Wall time spent making operators resident, s.
+    pub fn seconds(&self) -> f64 {
+        self.seconds
+    }
+
+    /// The operator for `spec`, built (or loaded) on first use; the second
+    /// value is the time that took (0 when it was already resident).
+    pub fn operator(&mut self, spec: &CaseSpec) -> Result<(&mut Operator, f64), SolverError> {
         let key = spec.kernel_key();
+        let mut took = 0.0;
         if !self.ops.contains_key(&key) {
-            let op = build_operator(&spec.material, spec.grid())?;
-            self.builds += 1;
+            let start = std::time::Instant::now();
+            let grid = spec.grid();
+            let len = 4 * grid.n * grid.n;
+            let persistent = !spec.material.is_isotropic();
+            let stored = match (&self.store, persistent) {
+                (Some(store), true) => store.load(&key, len),
+                _ => None,
+            };
+            let op = match stored {
+                Some(tables) => {
+                    self.loads += 1;
+                    Operator::from_tables(grid, &tables)
+                }
+                None => {
+                    let tables = kernel_tables(&spec.material, grid);
+                    if let (Some(store), true) = (&self.store, persistent) {
+                        store.save(&key, &tables);
+                    }
+                    self.builds += 1;
+                    Operator::from_tables(grid, &tables)
+                }
+            };
+            took = start.elapsed().as_secs_f64();
+            self.seconds += took;
             self.ops.insert(key.clone(), op);
         }
-        Ok(self.ops.get_mut(&key).expect("inserted above"))
+        Ok((self.ops.get_mut(&key).expect("inserted above"), took))
     }
 }
 
-/// Builds the DC-FFT operator of a material on a grid.
-pub fn build_operator(material: &Material, grid: Grid) -> Result<Operator, SolverError> {
-    let cell: Box<dyn Fn(f64, f64) -> Block> = match &material.elasticity {
+/// The real-space kernel tables of a material on a grid (see [`Operator::tables`]).
+pub fn kernel_tables(material: &Material, grid: Grid) -> Vec<Vec<f64>> {
+    match &material.elasticity {
         Elasticity::Isotropic(iso) => {
             let (g, nu) = (iso.shear(), iso.poisson);
-            Box::new(move |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy))
+            Operator::tables(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy))
         }
         Elasticity::Anisotropic(c) => {
             let kernel = crate::aniso::AngularKernel::new(c);
-            Box::new(move |x, y| {
+            Operator::tables(grid, |x, y| {
                 let k = crate::aniso::cell_influence(&kernel, x, y, grid.dx, grid.dy);
                 std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)]))
             })
         }
-    };
-    Ok(Operator::build(grid, cell))
+    }
 }
 
 /// The scalars of one solved case.
@@ -307,6 +360,10 @@ pub struct CaseScalars {
     pub tangential: TangentialReport,
     /// Wall time of the solve (operator build excluded), s.
     pub seconds: f64,
+    /// Wall time spent building or loading the operator for this case
+    /// (0 when it was already resident), s.
+    #[serde(default)]
+    pub kernel_seconds: f64,
 }
 
 /// Surface fields of a solved case, each `n x n`, row-major `[iy][ix]` (y rows, x columns).
@@ -397,7 +454,7 @@ fn touches_edge(n: usize, active: impl Fn(usize) -> bool) -> bool {
 /// Solves one case. The operator comes from (and stays in) `cache`.
 pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
     spec.validate()?;
-    let op = cache.operator(spec)?;
+    let (op, kernel_seconds) = cache.operator(spec)?;
     let start = std::time::Instant::now();
     let grid = spec.grid();
     let n = grid.n;
@@ -554,6 +611,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         normal: normal_report,
         tangential: tan_report,
         seconds: start.elapsed().as_secs_f64(),
+        kernel_seconds,
     };
     if fnorm > 0.0 {
         s.mu_a = Some(mu_apparent(&s, load, s.k_e));

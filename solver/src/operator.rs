@@ -64,10 +64,14 @@ impl Operator {
     /// Builds the nine kernel spectra from a cell-influence function
     /// `cell(x, y) -> K(x, y)` (offsets of the observation point from the loaded cell).
     pub fn build(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Self {
+        Self::from_tables(grid, &Self::tables(grid, cell))
+    }
+
+    /// The nine real-space kernels on the `2N x 2N` wrap-around grid
+    /// (`tables[3 i + j]`, row-major), the expensive part of a build.
+    pub fn tables(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Vec<Vec<f64>> {
         let n = grid.n;
         let m = 2 * n;
-        let mut fft = Fft2::new(n);
-        let slen = fft.spectrum_len();
         let mut real: Vec<Vec<f64>> = (0..9).map(|_| vec![0.0; m * m]).collect();
         for iy in 0..m {
             if iy == n {
@@ -93,6 +97,13 @@ impl Operator {
                 }
             }
         }
+        real
+    }
+
+    /// Builds the operator from the real-space kernels of [`Operator::tables`].
+    pub fn from_tables(grid: Grid, real: &[Vec<f64>]) -> Self {
+        let mut fft = Fft2::new(grid.n);
+        let slen = fft.spectrum_len();
         let kernels = real
             .iter()
             .map(|r| {

@@ -55,7 +55,7 @@ angles_deg = [30.0]
 "#;
 
 #[test]
-fn solve_writes_case_json_and_nine_npy_fields() {
+fn solve_writes_case_json_nine_npy_fields_and_five_maps() {
     let dir = temp_dir("solve");
     std::fs::write(dir.join("c.toml"), SMALL).unwrap();
     let out = run(&[
@@ -100,6 +100,10 @@ fn solve_writes_case_json_and_nine_npy_fields() {
             "{name}: {header}"
         );
         assert!(bytes.len() >= 64 * 64 * 8);
+    }
+    for name in ["p", "qx", "qy", "slip", "stick"] {
+        let bytes = std::fs::read(dir.join(format!("o/{name}.png"))).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{name}.png is a PNG");
     }
 }
 

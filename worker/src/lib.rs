@@ -10,6 +10,8 @@
 //! It exits cleanly when the coordinator answers `Done`, and on its own when
 //! the coordinator's node disappears (checked on every timed-wait timeout).
 
+pub mod kernel_store;
+
 use std::collections::HashSet;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -91,7 +93,7 @@ enum Answer {
 /// only when attaching fails or the coordinator rejects this worker.
 pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
     let w = attach(run_id, worker_index)?;
-    let mut cache = KernelCache::new();
+    let mut cache = kernel_store::FileStore::cache();
     let mut keys: HashSet<String> = HashSet::new();
     let mut next: WorkerMessage = ToCoord::Ready(Ready {
         worker_index: worker_index as u32,

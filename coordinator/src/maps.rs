@@ -1,0 +1,200 @@
+//! PNG contour maps of one case's surface fields, in the paper's style
+//! (Figs. 4, 5, 7, 8): p/p_H, qx/p_H, qy/p_H, slip magnitude and the
+//! stick/slip map, axes in units of the contact radius, with a colour bar.
+//! Drawing only; the fields come from `solver::case::Fields`.
+
+use anyhow::{anyhow, Context, Result};
+use plotters::prelude::*;
+use solver::case::{CaseScalars, Fields};
+use std::path::Path;
+
+/// Colour of `t ∈ [0, 1]` on a perceptually ordered ramp (dark blue → yellow).
+fn ramp(t: f64) -> RGBColor {
+    let stops = [
+        (0.0, (48, 18, 59)),
+        (0.25, (40, 120, 230)),
+        (0.5, (30, 200, 160)),
+        (0.75, (240, 200, 40)),
+        (1.0, (180, 20, 10)),
+    ];
+    let t = t.clamp(0.0, 1.0);
+    for w in stops.windows(2) {
+        let ((t0, c0), (t1, c1)) = (w[0], w[1]);
+        if t <= t1 {
+            let u = (t - t0) / (t1 - t0);
+            let mix = |a: u8, b: u8| (a as f64 + u * (b as f64 - a as f64)).round() as u8;
+            return RGBColor(mix(c0.0, c1.0), mix(c0.1, c1.1), mix(c0.2, c1.2));
+        }
+    }
+    RGBColor(180, 20, 10)
+}
+
+/// One map: `values` (n x n, row-major [iy][ix]) drawn over |x|, |y| ≤ extent·a.
+struct Map<'a> {
+    file: &'a str,
+    label: &'a str,
+    values: Vec<f64>,
+}
+
+fn draw_map(
+    path: &Path,
+    title: &str,
+    map: &Map,
+    n: usize,
+    dx: f64,
+    a: f64,
+    extent: f64,
+) -> Result<()> {
+    let root = BitMapBackend::new(path, (760, 640)).into_drawing_area();
+    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (main, bar) = root.split_horizontally(620);
+    let half = 0.5 * (n as f64 - 1.0);
+    let to_x = |i: usize| (i as f64 - half) * dx / a;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let inside = |i: usize| to_x(i).abs() <= extent;
+    for iy in (0..n).filter(|&i| inside(i)) {
+        for ix in (0..n).filter(|&i| inside(i)) {
+            let v = map.values[iy * n + ix];
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+    }
+    if !(lo.is_finite() && hi > lo) {
+        (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
+    }
+    let mut chart = ChartBuilder::on(&main)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(-extent..extent, -extent..extent)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x / a")
+        .y_desc("y / a")
+        .draw()
+        .map_err(|e| err(&e))?;
+    let h = 0.5 * dx / a;
+    chart
+        .draw_series((0..n).filter(|&i| inside(i)).flat_map(|iy| {
+            let values = &map.values;
+            (0..n).filter(move |&i| inside(i)).map(move |ix| {
+                let (x, y) = (to_x(ix), to_x(iy));
+                let t = (values[iy * n + ix] - lo) / (hi - lo);
+                Rectangle::new([(x - h, y - h), (x + h, y + h)], ramp(t).filled())
+            })
+        }))
+        .map_err(|e| err(&e))?;
+    // Colour bar.
+    let mut cb = ChartBuilder::on(&bar)
+        .caption(map.label, ("sans-serif", 14))
+        .margin_top(12)
+        .margin_bottom(50)
+        .margin_left(8)
+        .margin_right(8)
+        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(|e| err(&e))?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let steps = 200;
+    cb.draw_series((0..steps).map(|k| {
+        let (v0, v1) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+        );
+        Rectangle::new(
+            [(0.0, v0), (1.0, v1)],
+            ramp((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))
+    .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// Writes `p.png`, `qx.png`, `qy.png`, `slip.png` and `stick.png` into `dir`.
+/// `title` names the case (material, surface, ψ). Axes are x/a with a the
+/// apparent contact radius; tractions are normalised by the Hertz pressure p_H.
+pub fn write_maps(
+    dir: &Path,
+    title: &str,
+    fields: &Fields,
+    s: &CaseScalars,
+    spacing_m: f64,
+) -> Result<()> {
+    let n = fields.n;
+    let ph = s.hertz_pressure_pa;
+    let a = s.contact_radius_m.max(spacing_m);
+    let norm = |v: &[f64]| v.iter().map(|x| x / ph).collect::<Vec<f64>>();
+    let slip: Vec<f64> = fields
+        .sx
+        .iter()
+        .zip(&fields.sy)
+        .map(|(x, y)| x.hypot(*y) * 1e6)
+        .collect();
+    // Stick/slip map: 0 outside contact, 1 slip, 2 stick.
+    let status: Vec<f64> = (0..n * n)
+        .map(|i| {
+            if fields.p[i] <= 0.0 {
+                0.0
+            } else if fields.stick[i] > 0.5 {
+                2.0
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let maps = [
+        Map {
+            file: "p.png",
+            label: "p / p_H",
+            values: norm(&fields.p),
+        },
+        Map {
+            file: "qx.png",
+            label: "qx / p_H",
+            values: norm(&fields.qx),
+        },
+        Map {
+            file: "qy.png",
+            label: "qy / p_H",
+            values: norm(&fields.qy),
+        },
+        Map {
+            file: "slip.png",
+            label: "|s| (µm)",
+            values: slip,
+        },
+        Map {
+            file: "stick.png",
+            label: "0 free, 1 slip, 2 stick",
+            values: status,
+        },
+    ];
+    let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
+    for m in &maps {
+        let path = dir.join(m.file);
+        draw_map(
+            &path,
+            &format!("{title}: {}", m.label),
+            m,
+            n,
+            spacing_m,
+            a,
+            extent,
+        )
+        .with_context(|| format!("while drawing {}", path.display()))?;
+    }
+    Ok(())
+}
