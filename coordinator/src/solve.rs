@@ -111,7 +111,12 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     std::fs::write(&path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
     write_fields(args.out, &out.fields)?;
+    // The numbers are written first; a picture that cannot be drawn (e.g. no
+    // system font) is a warning, not a lost result.
     let title = format!("{material}, {surface}, ψ = {angle}°");
-    crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.spacing_m)?;
+    if let Err(e) = crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.spacing_m)
+    {
+        eprintln!("warning: maps not written: {e:#}");
+    }
     Ok(scalars)
 }
