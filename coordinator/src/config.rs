@@ -6,7 +6,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use solver::case::CaseSpec;
 use solver::material::{Elasticity, Isotropic, Material};
-use solver::surface::{Island, Surface};
+use solver::surface::{Island, LatticeKind, Surface};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -155,19 +155,28 @@ pub struct MaterialCfg {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceCfg {
-    /// `flat`, `circle` or `square`.
+    /// `flat`, `circle`, `square`, `stripe` or `heightmap`.
     pub shape: String,
     /// Circle diameter, µm.
     pub diameter_um: Option<f64>,
     /// Square side, µm.
     pub side_um: Option<f64>,
-    /// Lattice pitch, µm.
+    /// Stripe (ridge) width, µm.
+    pub width_um: Option<f64>,
+    /// Lattice or stripe pitch, µm.
     pub pitch_um: Option<f64>,
-    /// Island height, µm (negative: dimples).
+    /// Island / ridge height, µm (negative: dimples / grooves).
     pub height_um: Option<f64>,
-    /// Position of one island centre relative to the sphere apex, µm.
+    /// `square` (default) or `hexagonal` island lattice.
+    pub lattice: Option<String>,
+    /// Ridge direction for stripes, degrees from x (default 90: ridges along y).
+    pub angle_deg: Option<f64>,
+    /// Position of one island centre (or ridge line) relative to the sphere apex, µm.
     #[serde(default)]
     pub offset_um: [f64; 2],
+    /// Height map: a 2-D float64 `.npy` of heights in µm, shape (N, N) = the grid,
+    /// rows along y; a relative path is taken from the config file's directory.
+    pub file: Option<String>,
 }
 
 /// `[solver]`
@@ -235,6 +244,39 @@ pub struct OutputCfg {
     pub save_fields: bool,
 }
 
+/// `[run]`: how the sweep runner treats its workers (not physics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunCfg {
+    /// Floor of the per-case deadline, s. A case in flight longer than
+    /// max(this, [`HUNG_FACTOR`] × the longest case recorded so far) is
+    /// taken from its worker (killed when the coordinator started it) and
+    /// dispatched again.
+    #[serde(default = "default_case_timeout")]
+    pub case_timeout_s: f64,
+}
+
+/// Multiple of the longest observed case time after which a case is hung.
+pub const HUNG_FACTOR: f64 = 10.0;
+
+fn default_case_timeout() -> f64 {
+    60.0
+}
+
+impl Default for RunCfg {
+    fn default() -> Self {
+        RunCfg {
+            case_timeout_s: default_case_timeout(),
+        }
+    }
+}
+
+impl RunCfg {
+    fn is_default(&self) -> bool {
+        *self == RunCfg::default()
+    }
+}
+
 /// The whole config file.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -259,6 +301,13 @@ pub struct Config {
     /// `[output]`
     #[serde(default)]
     pub output: OutputCfg,
+    /// `[run]` (left out of the config echo when it is the default, so
+    /// journals written before it existed still resume).
+    #[serde(default, skip_serializing_if = "RunCfg::is_default")]
+    pub run: RunCfg,
+    /// Directory that relative paths in the config (height maps) start from.
+    #[serde(skip)]
+    pub base_dir: std::path::PathBuf,
 }
 
 /// A case's identity in a sweep: `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`.
@@ -319,13 +368,20 @@ impl Config {
     pub fn load(path: &Path, sets: &[String]) -> Result<Config> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read config {}", path.display()))?;
-        Self::parse(&text, sets).with_context(|| format!("in config {}", path.display()))
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::parse_in(&text, sets, &base).with_context(|| format!("in config {}", path.display()))
     }
 
-    /// Parses config text and applies `--set` overrides.
+    /// Parses config text and applies `--set` overrides (relative paths from the current directory).
     pub fn parse(text: &str, sets: &[String]) -> Result<Config> {
+        Self::parse_in(text, sets, Path::new(""))
+    }
+
+    /// Parses config text and applies `--set` overrides; relative paths start at `base`.
+    pub fn parse_in(text: &str, sets: &[String], base: &Path) -> Result<Config> {
         // First pass on the text itself: errors carry line and column.
-        let cfg: Config = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        let mut cfg: Config = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        cfg.base_dir = base.to_path_buf();
         if sets.is_empty() {
             cfg.check()?;
             return Ok(cfg);
@@ -334,9 +390,10 @@ impl Config {
         for s in sets {
             apply_set(&mut table, s)?;
         }
-        let cfg: Config = toml::Value::Table(table)
+        let mut cfg: Config = toml::Value::Table(table)
             .try_into()
             .map_err(|e| anyhow!("after --set {}: {e}", sets.join(" --set ")))?;
+        cfg.base_dir = base.to_path_buf();
         cfg.check()?;
         Ok(cfg)
     }
@@ -355,6 +412,10 @@ impl Config {
             bail!("sweep.surfaces: list at least one surface");
         }
         self.sweep.angles_deg.values()?;
+        let t = self.run.case_timeout_s;
+        if !(t.is_finite() && t > 0.0) {
+            bail!("run.case_timeout_s = {t}: must be a positive number of seconds");
+        }
         for (_, spec) in self.cases()? {
             spec.validate().map_err(|e| anyhow!("{e}"))?;
         }
@@ -384,7 +445,7 @@ impl Config {
     /// Resolves a surface name: `[surfaces.NAME]` first, then presets.
     pub fn surface(&self, name: &str) -> Result<Surface> {
         if let Some(s) = self.surfaces.get(name) {
-            return build_surface(name, s);
+            return build_surface(name, s, self.grid.points, &self.base_dir);
         }
         solver::presets::surface(name).ok_or_else(|| {
             anyhow!("sweep.surfaces: unknown surface `{name}` (presets: flat, circle-A, circle-B, square-A, square-B; or define [surfaces.\"{name}\"])")
@@ -492,7 +553,7 @@ fn build_material(name: &str, m: &MaterialCfg) -> Result<Material> {
     })
 }
 
-fn build_surface(name: &str, s: &SurfaceCfg) -> Result<Surface> {
+fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Surface> {
     let need = |v: Option<f64>, k: &str| {
         v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{}\"", s.shape))
     };
@@ -509,19 +570,68 @@ fn build_surface(name: &str, s: &SurfaceCfg) -> Result<Surface> {
                     side: need(s.side_um, "side_um")? * um,
                 }
             };
+            let lattice = match s.lattice.as_deref() {
+                None | Some("square") => LatticeKind::Square,
+                Some("hexagonal") => LatticeKind::Hexagonal,
+                Some(other) => bail!("surfaces.{name}.lattice: unknown lattice `{other}` (square, hexagonal)"),
+            };
             Surface::Lattice {
                 island,
                 pitch: need(s.pitch_um, "pitch_um")? * um,
                 height: need(s.height_um, "height_um")? * um,
                 offset: [s.offset_um[0] * um, s.offset_um[1] * um],
+                lattice,
             }
         }
-        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square)"),
+        "stripe" => Surface::Stripes {
+            width: need(s.width_um, "width_um")? * um,
+            pitch: need(s.pitch_um, "pitch_um")? * um,
+            height: need(s.height_um, "height_um")? * um,
+            angle_deg: s.angle_deg.unwrap_or(90.0),
+            offset: s.offset_um[0] * um,
+        },
+        "heightmap" => {
+            let file = s
+                .file
+                .as_ref()
+                .ok_or_else(|| anyhow!("surfaces.{name}.file: required for shape = \"heightmap\""))?;
+            let path = base.join(file);
+            let (shape, values) = read_npy_f64(&path)
+                .with_context(|| format!("surfaces.{name}.file: cannot read {}", path.display()))?;
+            if shape != [n as u64, n as u64] {
+                bail!(
+                    "surfaces.{name}.file: {} has shape {shape:?} but the grid is {n} x {n} (grid.points)",
+                    path.display()
+                );
+            }
+            Surface::Heightmap {
+                n,
+                heights: values.iter().map(|v| v * um).collect(),
+            }
+        }
+        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap)"),
     };
     surface
-        .validate()
+        .validate(n)
         .map_err(|e| anyhow!("surfaces.{name}: {e}"))?;
     Ok(surface)
+}
+
+/// Reads a float64 (or float32) `.npy` file: shape and values in C order.
+fn read_npy_f64(path: &Path) -> Result<(Vec<u64>, Vec<f64>)> {
+    let bytes = std::fs::read(path)?;
+    let npy = npyz::NpyFile::new(&bytes[..])?;
+    let shape = npy.shape().to_vec();
+    if npy.order() != npyz::Order::C {
+        bail!("Fortran-ordered arrays are not supported; save with numpy's default C order");
+    }
+    let values: Vec<f64> = match npy.dtype() {
+        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 => {
+            npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
+        }
+        _ => npy.into_vec::<f64>()?,
+    };
+    Ok((shape, values))
 }
 
 #[cfg(test)]
@@ -643,6 +753,32 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         let nan_h = format!("{BASE}\n[surfaces.odd]\nshape = \"square\"\nside_um = 10.0\npitch_um = 40.0\nheight_um = nan\n")
             .replace("surfaces = [\"flat\"]", "surfaces = [\"odd\"]");
         assert!(err(&nan_h, &[]).contains("height"), "{}", err(&nan_h, &[]));
+    }
+
+    #[test]
+    fn heightmap_surface_is_read_from_npy_and_its_shape_checked() {
+        let dir = std::env::temp_dir().join(format!("mpcontact-hmap-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let heights: Vec<f64> = (0..64 * 64)
+            .map(|i| if i % 7 == 0 { 0.5 } else { 0.0 })
+            .collect();
+        crate::solve::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        crate::solve::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
+        let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
+        let c = Config::parse_in(&text, &[], &dir).unwrap();
+        let Surface::Heightmap { n, heights: h } = c.surface("rough").unwrap() else {
+            panic!("not a height map")
+        };
+        assert_eq!(n, 64);
+        assert_eq!(h[0], 0.5e-6, "µm in the file, m in the solver");
+        let small = text.replace("h.npy", "small.npy");
+        let e = format!("{:#}", Config::parse_in(&small, &[], &dir).unwrap_err());
+        assert!(e.contains("grid is 64 x 64"), "{e}");
+        let missing = text.replace("h.npy", "nope.npy");
+        let e = format!("{:#}", Config::parse_in(&missing, &[], &dir).unwrap_err());
+        assert!(e.contains("surfaces.rough.file"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -343,3 +343,379 @@ fn killed_worker_is_detected_and_its_case_requeued() {
     assert!(workers >= 2, "{summary}");
     assert_eq!(shm_leftovers("e"), Vec::<String>::new());
 }
+
+/// Run `cmd` with stderr piped; return its exit status and stderr lines,
+/// each with the wall-clock time it was read.
+fn run_timed(
+    mut cmd: Command,
+    during: impl FnOnce(u32),
+) -> (
+    std::process::ExitStatus,
+    Vec<(std::time::SystemTime, String)>,
+) {
+    use std::io::BufRead;
+    let mut child = cmd.stderr(std::process::Stdio::piped()).spawn().unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+            .map(|l| (std::time::SystemTime::now(), l))
+            .collect::<Vec<_>>()
+    });
+    during(child.id());
+    let status = child.wait().unwrap();
+    (status, reader.join().unwrap())
+}
+
+fn mtime(p: &Path) -> std::time::SystemTime {
+    std::fs::metadata(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .modified()
+        .unwrap()
+}
+
+fn summary(o: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(o.join("summary.json")).unwrap()).unwrap()
+}
+
+fn assert_every_case_once(o: &Path) -> BTreeMap<String, serde_json::Value> {
+    let journal = journal_cases(o);
+    let by_id: BTreeMap<String, serde_json::Value> = journal
+        .iter()
+        .map(|v| (v["case_id"].as_str().unwrap().to_string(), v.clone()))
+        .collect();
+    assert_eq!(journal.len(), CASES, "a case recorded twice or lost");
+    assert_eq!(by_id.len(), CASES);
+    assert_eq!(read_csv(&o.join("results.csv")).len() - 1, CASES);
+    by_id
+}
+
+/// A worker that stops responding but stays alive (test hook
+/// `MPCONTACT_TEST_HANG_CASE`, once) is caught by the per-case deadline
+/// (`[run] case_timeout_s = 2` floor), SIGKILLed and replaced; its case is
+/// solved by another worker. While it hangs, the run is also checked for
+/// isolation: a second `run` into the same output directory is refused, the
+/// iceoryx2 root directory is mode 0700 and no shared-memory file of the run
+/// is readable by others.
+#[test]
+fn hung_worker_is_killed_and_replaced_and_the_active_run_is_private() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("hang");
+    std::fs::write(
+        dir.join("sweep.toml"),
+        format!("{CONFIG}\n[run]\ncase_timeout_s = 2\n"),
+    )
+    .unwrap();
+    let marker = dir.join("hang.marker");
+    let hung_case = "Cu/flat/045.0";
+    let mut cmd = sweep_cmd(&dir, "out", 2, "f");
+    cmd.env("MPCONTACT_TEST_HANG_CASE", hung_case)
+        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    let o = dir.join("out");
+    let dir2 = dir.clone();
+    let (status, lines) = run_timed(cmd, |_| {
+        let t = std::time::Instant::now();
+        while !marker.exists() {
+            assert!(t.elapsed().as_secs() < 120, "the hang hook never fired");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // The run is active now: the output directory is taken.
+        let second = sweep_cmd(&dir2, "out", 1, "f").output().unwrap();
+        assert!(!second.status.success());
+        let err = String::from_utf8_lossy(&second.stderr);
+        assert!(err.contains("in use by a running sweep"), "{err}");
+        // iceoryx2 lives in a private per-user root.
+        let root = protocol::ipc_root_dir().unwrap();
+        let mode = std::fs::metadata(&root).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o700, "{}", root.display());
+        // Segments of this run: owner-only (iceoryx2's 16-byte global_mgmt
+        // counter is the one exception, see docs/faults.md).
+        let mut segments = 0;
+        for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            if name.starts_with(&prefix("f")) && !name.ends_with("global_mgmt") {
+                let mode = e.metadata().unwrap().permissions().mode() & 0o777;
+                assert_eq!(mode & 0o077, 0, "{name} has mode {mode:o}");
+                segments += 1;
+            }
+        }
+        assert!(segments > 0, "no shared-memory segment of the run found");
+    });
+    let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert!(status.success(), "{}", text.join("\n"));
+    eprintln!("{}", text.join("\n"));
+    let (seen, hung) = lines
+        .iter()
+        .find(|(_, l)| l.contains("hung:") && l.contains(hung_case))
+        .unwrap_or_else(|| panic!("no hang reported:\n{}", text.join("\n")));
+    assert!(hung.contains("killing it"), "{hung}");
+    let detected = seen.duration_since(mtime(&marker)).unwrap();
+    eprintln!(
+        "MEASURED hung worker detected {:.2} s after it stopped answering",
+        detected.as_secs_f64()
+    );
+    assert!(detected.as_secs_f64() >= 1.9, "{detected:?}");
+    assert!(detected.as_secs() < 60, "{detected:?}");
+
+    let by_id = assert_every_case_once(&o);
+    assert_ne!(by_id[hung_case]["status"], "failed", "{}", by_id[hung_case]);
+    let s = summary(&o);
+    let per_worker = s["per_worker"].as_object().unwrap();
+    assert_eq!(
+        per_worker.values().filter(|w| w["died"] == true).count(),
+        1,
+        "{s}"
+    );
+    assert!(per_worker.len() >= 3, "no replacement was spawned: {s}");
+    assert_eq!(shm_leftovers("f"), Vec::<String>::new());
+}
+
+/// A case that aborts every worker it is given (test hook
+/// `MPCONTACT_TEST_CRASH_CASE`) is tried twice, then recorded as failed;
+/// the rest of the sweep completes and the failure is reported.
+#[test]
+fn case_that_crashes_its_worker_twice_is_marked_failed() {
+    let dir = scratch("crash");
+    let bad = "Ni/circle-A/000.0";
+    let mut cmd = sweep_cmd(&dir, "out", 2, "g");
+    cmd.env("MPCONTACT_TEST_CRASH_CASE", bad);
+    let o = dir.join("out");
+    let (status, lines) = run_timed(cmd, |_| {});
+    let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert!(status.success(), "{}", text.join("\n"));
+    eprintln!("{}", text.join("\n"));
+    let by_id = assert_every_case_once(&o);
+    assert_eq!(by_id[bad]["status"], "failed");
+    let why = by_id[bad]["error"].as_str().unwrap();
+    assert!(why.contains("2 times"), "{why}");
+    // Other cases may fail on their own physics (statuses are the solver's
+    // business), never because of the crashing one.
+    for (id, v) in &by_id {
+        if id != bad {
+            assert!(!v["error"].to_string().contains("died"), "{id}: {v}");
+        }
+    }
+    let s = summary(&o);
+    assert!(s["failed"].as_u64().unwrap() >= 1, "{s}");
+    assert!(s["failures"][bad].as_str().unwrap().contains("2 times"));
+    let curves = std::fs::read_to_string(o.join("curves.csv")).unwrap();
+    assert!(!curves.contains("\nNi,circle-A,0,"), "{curves}");
+    assert!(
+        text.iter().any(|l| l.contains("failed") && l.contains(bad)),
+        "not reported at the end"
+    );
+    // Detection time: worker log written just before abort → coordinator note.
+    for (seen, line) in &lines {
+        if let Some(rest) = line.strip_prefix("worker ") {
+            if line.contains("died while solving") {
+                let k = rest.split_whitespace().next().unwrap();
+                let log = o.join(format!("worker-logs/worker-{k}.log"));
+                let d = seen.duration_since(mtime(&log)).unwrap_or_default();
+                eprintln!(
+                    "MEASURED crashed worker {k} detected {:.3} s after its abort",
+                    d.as_secs_f64()
+                );
+                assert!(d.as_secs() < 10, "{d:?}");
+            }
+        }
+    }
+    assert_eq!(shm_leftovers("g"), Vec::<String>::new());
+}
+
+/// `--resume` with a config that differs from the journalled one is refused
+/// before any worker starts, naming the differing line.
+#[test]
+fn resume_with_a_different_config_is_refused_saying_what_differs() {
+    let dir = scratch("resume-diff");
+    let small = [
+        "--set",
+        "sweep.materials=[\"Cu\"]",
+        "--set",
+        "sweep.surfaces=[\"flat\"]",
+    ];
+    let mut c = sweep_cmd(&dir, "out", 1, "h");
+    c.args(small);
+    check_ok(&c.output().unwrap(), "small sweep");
+    let mut c = sweep_cmd(&dir, "out", 1, "h");
+    c.args(small)
+        .args(["--set", "load.friction=0.4", "--resume"]);
+    let out = c.output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("different config") && err.contains("friction = 0.3") && err.contains("0.4"),
+        "{err}"
+    );
+    // The same config resumes (nothing left to do).
+    let mut c = sweep_cmd(&dir, "out", 1, "h");
+    c.args(small).arg("--resume");
+    check_ok(&c.output().unwrap(), "resume with the same config");
+    assert_eq!(summary(&dir.join("out"))["resumed"], 3);
+    assert!(shm_leftovers("h").is_empty());
+}
+
+type FakeClient =
+    iceoryx2::port::client::Client<iceoryx2::prelude::ipc::Service, [u8], (), [u8], ()>;
+
+/// Send one request as the test's fake worker; return the decoded answer
+/// (or the decode error) when one comes within 3 s.
+fn fake_request(
+    client: &FakeClient,
+    notifier: &iceoryx2::port::notifier::Notifier<iceoryx2::prelude::ipc::Service>,
+    run: &str,
+    msg: protocol::ToCoord<worker::WireScalars>,
+    extra: &[f64],
+    version: Option<u32>,
+) -> Option<String> {
+    let mut env = protocol::Envelope::new(run, msg);
+    if let Some(v) = version {
+        env.version = v;
+    }
+    let header = protocol::encode_header(&env).unwrap();
+    let len = protocol::frame_len(header.len(), extra.len());
+    let mut req = client.loan_slice(len).unwrap();
+    protocol::encode_into(req.payload_mut(), &header, &[extra]).unwrap();
+    if let Some(v) = version {
+        req.payload_mut()[4..8].copy_from_slice(&v.to_le_bytes());
+    }
+    let pending = req.send().unwrap();
+    assert!(pending.number_of_server_connections() > 0, "no coordinator");
+    notifier.notify().unwrap();
+    let t = std::time::Instant::now();
+    while t.elapsed().as_secs() < 3 {
+        if let Some(r) = pending.receive().unwrap() {
+            return Some(
+                match protocol::decode_to_worker::<worker::WireSpec>(r.payload(), run) {
+                    Ok(d) => format!("{:?}", d.header.body),
+                    Err(e) => format!("undecodable: {e}"),
+                },
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    None
+}
+
+/// A live fake worker (iceoryx2 client built here with `protocol`'s encode
+/// helpers) attaches to a running sweep by the run id in the journal header
+/// and sends: a message of another protocol version, a result for an
+/// unknown case, a duplicate result for a recorded case, and a result with
+/// a wrong array length. Each is rejected with a logged reason and counted
+/// in `summary.json`; the sweep completes with every case once. (The real
+/// worker is held on one case by the hang hook so the run stays open.)
+#[test]
+fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
+    use iceoryx2::prelude::*;
+    let dir = scratch("badmsg");
+    std::fs::write(
+        dir.join("sweep.toml"),
+        format!("{CONFIG}\n[run]\ncase_timeout_s = 8\n"),
+    )
+    .unwrap();
+    let marker = dir.join("hang.marker");
+    let mut cmd = sweep_cmd(&dir, "out", 1, "i");
+    cmd.env("MPCONTACT_TEST_HANG_CASE", "Ni/circle-A/045.0")
+        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    let o = dir.join("out");
+    let (status, lines) = run_timed(cmd, |_| {
+        let t = std::time::Instant::now();
+        while !marker.exists() {
+            assert!(t.elapsed().as_secs() < 120, "the hang hook never fired");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let journal = std::fs::read_to_string(o.join("journal.jsonl")).unwrap();
+        let head: serde_json::Value =
+            serde_json::from_str(journal.lines().next().unwrap()).unwrap();
+        let run = head["run_id"].as_str().unwrap().to_string();
+        let done = journal_cases(&o)[0]["case_id"]
+            .as_str()
+            .unwrap()
+            .to_string();
+
+        let mut cfg = protocol::ipc_config().unwrap();
+        cfg.global.prefix = FileName::new(prefix("i").as_bytes()).unwrap();
+        let node = protocol::create_node(
+            &cfg,
+            &protocol::worker_node_name(&run, 77),
+            SignalHandlingMode::Disabled,
+        )
+        .unwrap();
+        let client = protocol::work_service_port(&node, &run, 0, false)
+            .unwrap()
+            .client_builder()
+            .initial_max_slice_len(4096)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .unwrap();
+        let notifier =
+            protocol::event_service_port(&node, &protocol::to_coord_event(&run), 0, false)
+                .unwrap()
+                .notifier_builder()
+                .create()
+                .unwrap();
+        let result = |case: &str| {
+            protocol::ToCoord::Result(protocol::ResultHeader {
+                case_id: case.to_string(),
+                worker_index: 77,
+                grid_n: 32,
+                solve_seconds: 0.1,
+                kernel_builds: 1,
+                kernels_resident: 1,
+                sent_unix_ns: 0,
+                field_names: Vec::new(),
+                scalars: worker::WireScalars::default(),
+            })
+        };
+        let ready = protocol::ToCoord::Ready(protocol::Ready {
+            worker_index: 77,
+            pid: std::process::id(),
+        });
+        let answer = fake_request(&client, &notifier, &run, ready, &[], Some(999));
+        let answer = answer.expect("no answer to another protocol version");
+        assert!(
+            answer.contains("Rejected") && answer.contains("999"),
+            "{answer}"
+        );
+        fake_request(&client, &notifier, &run, result("Zz/flat/000.0"), &[], None);
+        fake_request(&client, &notifier, &run, result(&done), &[], None);
+        fake_request(
+            &client,
+            &notifier,
+            &run,
+            result("Ni/circle-A/045.0"),
+            &[1.0, 2.0, 3.0],
+            None,
+        );
+    });
+    let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    let all = text.join("\n");
+    assert!(status.success(), "{all}");
+    eprintln!("{all}");
+    for why in [
+        "protocol version 999",
+        "result for unknown case \"Zz/flat/000.0\"",
+        "duplicate result",
+        "Ni/circle-A/045.0",
+    ] {
+        assert!(
+            text.iter()
+                .any(|l| l.contains("rejected") || l.contains("ignored"))
+                && all.contains(why),
+            "no log line for {why}"
+        );
+    }
+    assert!(
+        text.iter()
+            .any(|l| l.starts_with("rejected a result") && l.contains("Ni/circle-A/045.0")),
+        "{all}"
+    );
+    let by_id = assert_every_case_once(&o);
+    assert_ne!(by_id["Ni/circle-A/045.0"]["worker"], 77);
+    for (id, v) in &by_id {
+        assert!(!v["error"].to_string().contains("died"), "{id}: {v}");
+    }
+    let s = summary(&o);
+    assert!(s["rejected_messages"].as_u64().unwrap() >= 4, "{s}");
+    assert_eq!(shm_leftovers("i"), Vec::<String>::new());
+}

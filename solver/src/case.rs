@@ -201,7 +201,7 @@ impl CaseSpec {
                 SolverError::invalid(&format!("materials.{}.stiffness", self.material.name), r)
             })?;
         }
-        self.surface.validate()?;
+        self.surface.validate(self.grid_points)?;
         Ok(())
     }
 }
@@ -581,7 +581,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         [1.0, 0.0]
     };
     let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let base_contact = matches!(spec.surface, crate::surface::Surface::Lattice { .. })
+    let base_contact = !matches!(spec.surface, crate::surface::Surface::Flat)
         && (0..len).any(|i| contact[i] && heights[i] < top);
     let eq = spec.material.equivalent;
     let hertz_radius = (3.0 * load * spec.indenter_radius_m / (4.0 * eq.plane_strain())).cbrt();

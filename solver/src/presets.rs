@@ -53,6 +53,7 @@ pub fn surfaces() -> Vec<(&'static str, Surface)> {
         pitch: pitch_um * UM,
         height: 30.0 * UM,
         offset: [0.0, 0.0],
+        lattice: crate::surface::LatticeKind::Square,
     };
     let circle = Island::Circle {
         diameter: 400.0 * UM,

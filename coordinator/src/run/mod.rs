@@ -216,6 +216,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
             out_dir: &args.out_dir,
             save_fields,
             progress: &progress,
+            case_timeout: std::time::Duration::from_secs_f64(args.config.run.case_timeout_s),
         })?;
         let outcome = session.serve(&mut plan, &mut journal, &mut records);
         let stats = session.shutdown();

@@ -355,6 +355,7 @@ mod tests {
             pitch: 1.28e-3,
             height: 3e-5,
             offset: [0.0, 0.0],
+            lattice: solver::surface::LatticeKind::Square,
         };
         let flat = aniso_case("Cu(111)/flat/030.0", Surface::Flat);
         let pat = aniso_case("Cu(111)/circle-A/030.0", lattice);

@@ -170,6 +170,7 @@ mod tests {
             pitch: 1.28e-3,
             height: 3e-5,
             offset: [0.0, 0.0],
+            lattice: solver::surface::LatticeKind::Square,
         };
         let p = Plan::new(vec![
             ("A/flat/000.0".into(), spec("A", 0.0)),

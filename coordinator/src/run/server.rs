@@ -75,6 +75,8 @@ pub struct SessionArgs<'a> {
     pub save_fields: bool,
     /// Progress reporter.
     pub progress: &'a Progress,
+    /// Floor of the per-case deadline (`run.case_timeout_s`).
+    pub case_timeout: Duration,
 }
 
 /// What a session measured, for the summary.
@@ -100,6 +102,8 @@ pub struct Session<'a> {
     spawns_left: usize,
     rejected: usize,
     ipc_ms: BTreeMap<u32, (Vec<f64>, Vec<f64>, usize)>,
+    /// Longest dispatch → record time of a case seen so far.
+    longest_case: Duration,
 }
 
 fn unix_ns() -> u64 {
@@ -156,6 +160,7 @@ impl<'a> Session<'a> {
             next_index: 0,
             rejected: 0,
             ipc_ms: BTreeMap::new(),
+            longest_case: Duration::ZERO,
         };
         for _ in 0..s.args.workers {
             s.spawn()?;
@@ -330,7 +335,9 @@ impl<'a> Session<'a> {
                     if let Some(i) = in_flight {
                         if matches!(plan.cases[i].state, CaseState::InFlight { worker: w, .. } if w == worker)
                         {
+                            // Handed back, not crashed on: not an attempt.
                             plan.cases[i].state = CaseState::Pending;
+                            plan.cases[i].attempts = plan.cases[i].attempts.saturating_sub(1);
                         }
                     }
                     worker
@@ -397,7 +404,10 @@ impl<'a> Session<'a> {
             // NaN/∞ scalars are deterministic physics, not a transport fault:
             // recomputing would give the same, so record the failure now.
             let deterministic = matches!(e, protocol::ProtocolError::NonFinite { .. });
-            if deterministic || case.attempts >= MAX_ATTEMPTS {
+            // Only the worker the case is in flight to can fail or requeue
+            // it; a bad result from anyone else is just rejected.
+            let mine = matches!(case.state, CaseState::InFlight { worker: w, .. } if w == worker);
+            if mine && (deterministic || case.attempts >= MAX_ATTEMPTS) {
                 let rec = Record {
                     case_id: h.case_id.clone(),
                     status: "failed".into(),
@@ -408,7 +418,7 @@ impl<'a> Session<'a> {
                     scalars: None,
                 };
                 self.commit(plan, journal, records, i, worker, rec)?;
-            } else {
+            } else if mine {
                 case.state = CaseState::Pending;
             }
             return Ok(());
@@ -473,6 +483,9 @@ impl<'a> Session<'a> {
             rec.error = Some("result holds non-finite values".into());
         }
         journal.append(&Line::Case(Box::new(rec.clone())))?;
+        if let CaseState::InFlight { since, .. } = plan.cases[i].state {
+            self.longest_case = self.longest_case.max(since.elapsed());
+        }
         plan.cases[i].state = CaseState::Done;
         if let Some(slot) = self.slots.get_mut(&worker) {
             slot.stats.cases += 1;
@@ -595,10 +608,31 @@ impl<'a> Session<'a> {
         if saw_dead {
             self.node.try_cleanup_dead_nodes();
         }
+        let deadline = self.case_deadline();
         let mut died = Vec::new();
         for (k, slot) in self.slots.iter_mut() {
             if slot.dead {
                 continue;
+            }
+            if let Some(i) = slot.in_flight {
+                if let CaseState::InFlight { worker, since } = plan.cases[i].state {
+                    let took = since.elapsed();
+                    if worker == *k && took > deadline {
+                        self.args.progress.note(&format!(
+                            "worker {k} hung: {} in flight for {:.1} s (deadline {:.1} s); {}",
+                            plan.cases[i].id,
+                            took.as_secs_f64(),
+                            deadline.as_secs_f64(),
+                            if slot.child.is_some() {
+                                "killing it"
+                            } else {
+                                "dropping it (not started by this coordinator, so not killed)"
+                            }
+                        ));
+                        died.push(*k);
+                        continue;
+                    }
+                }
             }
             let exited = match &mut slot.child {
                 Some(c) => matches!(c.try_wait(), Ok(Some(_))),
@@ -631,7 +665,10 @@ impl<'a> Session<'a> {
                         let rec = Record {
                             case_id: case.id.clone(),
                             status: "failed".into(),
-                            error: Some(format!("worker died on it {} times", case.attempts)),
+                            error: Some(format!(
+                                "its worker died or hung on it {} times",
+                                case.attempts
+                            )),
                             worker: k as u32,
                             seconds: 0.0,
                             kernel_builds: 0,
@@ -654,6 +691,14 @@ impl<'a> Session<'a> {
             );
         }
         Ok(())
+    }
+
+    /// How long a case may be in flight before its worker counts as hung:
+    /// max(`run.case_timeout_s`, HUNG_FACTOR × the longest case so far).
+    fn case_deadline(&self) -> Duration {
+        self.args
+            .case_timeout
+            .max(self.longest_case.mul_f64(crate::config::HUNG_FACTOR))
     }
 
     /// Tell held workers `Done`, stop stragglers, and report statistics.

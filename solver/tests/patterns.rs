@@ -1,0 +1,218 @@
+//! Micropatterned surfaces and the apparent friction μa (PHYSICS.md §7, ladder
+//! step 7): vanishing patterns, the paper's Table 1(c) patterns, and the
+//! symmetries μa must have.
+
+use solver::case::{calibrate_k_e, solve_case, CaseOutput, CaseSpec, KernelCache};
+use solver::surface::{Island, LatticeKind, Surface};
+
+/// Paper Table 1(c) conditions on `n` cells of `spacing_um`.
+fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64) -> CaseSpec {
+    CaseSpec {
+        material: solver::presets::material(material).unwrap(),
+        surface: solver::presets::surface(surface).unwrap(),
+        grid_points: n,
+        spacing_m: spacing_um * 1e-6,
+        indenter_radius_m: 0.2,
+        normal_force_n: 6000.0,
+        friction: 0.3,
+        tangential_ratio: 0.6,
+        angle_deg: angle,
+        coupling: true,
+        tolerance: 1e-10,
+        tangential_tolerance: 1e-6,
+        max_iterations: 5000,
+        coupling_tolerance: 1e-8,
+        max_coupling_iterations: 50,
+    }
+}
+
+fn solve(spec: &CaseSpec, cache: &mut KernelCache) -> CaseOutput {
+    let out = solve_case(spec, cache).unwrap();
+    assert!(out.scalars.converged, "{:?}", out.scalars);
+    let s = &out.scalars;
+    let f = spec.tangential_force();
+    assert!(
+        (s.normal_force_n / spec.normal_force_n - 1.0).abs() < 1e-8,
+        "Σ p ΔA = P"
+    );
+    let fe = (s.tangential_force_n[0] - f[0]).hypot(s.tangential_force_n[1] - f[1]);
+    assert!(fe < 1e-8 * f[0].hypot(f[1]), "Σ q ΔA = F");
+    out
+}
+
+#[test]
+fn a_pattern_of_vanishing_height_gives_the_flat_result() {
+    let mut cache = KernelCache::new();
+    let flat = solve(&table_1c("Cu", "flat", 128, 40.0, 0.0), &mut cache);
+    let mut spec = table_1c("Cu", "circle-B", 128, 40.0, 0.0);
+    if let Surface::Lattice { height, .. } = &mut spec.surface {
+        *height = 1e-13;
+    }
+    let low = solve(&spec, &mut cache);
+    let dp = flat
+        .fields
+        .p
+        .iter()
+        .zip(&low.fields.p)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let (a, b) = (&flat.scalars, &low.scalars);
+    println!(
+        "max |Δp| / p_max = {:.2e}; μa {} vs {}",
+        dp / a.p_max_pa,
+        a.mu_a.unwrap(),
+        b.mu_a.unwrap()
+    );
+    assert!(dp < 1e-6 * a.p_max_pa);
+    assert!((a.delta_t_m / b.delta_t_m - 1.0).abs() < 1e-6);
+    assert!((a.mu_a.unwrap() / b.mu_a.unwrap() - 1.0).abs() < 1e-6);
+}
+
+/// Cells on an island with a neighbour off the island.
+fn edge_cells(h: &[f64], n: usize) -> Vec<bool> {
+    (0..n * n)
+        .map(|i| {
+            let (x, y) = (i % n, i / n);
+            h[i] > 0.0
+                && x > 0
+                && y > 0
+                && x + 1 < n
+                && y + 1 < n
+                && [i - 1, i + 1, i - n, i + n].iter().any(|&j| h[j] <= 0.0)
+        })
+        .collect()
+}
+
+#[test]
+fn table_1c_patterns_contact_island_tops_and_dense_patterns_lower_mu_a() {
+    let mut cache = KernelCache::new();
+    let mut rows = Vec::new();
+    for surface in ["flat", "circle-A", "circle-B", "square-A", "square-B"] {
+        let spec = table_1c("Cu", surface, 192, 40.0, 0.0);
+        let out = solve(&spec, &mut cache);
+        let s = &out.scalars;
+        let n = spec.grid_points;
+        let h = spec.surface.heights(&spec.grid());
+        // Where does the shear traction peak? On an island edge cell.
+        let imax = (0..n * n)
+            .max_by(|&i, &j| out.fields.qx[i].abs().total_cmp(&out.fields.qx[j].abs()))
+            .unwrap();
+        let on_edge = edge_cells(&h, n)[imax];
+        println!(
+            "{surface:9} μa = {:.4}  a = {:.3} mm  c = {:.3} mm  stick area = {:.3} mm²  p_max/p_H = {:.2}  q_max/p_H = {:.2}  base touched: {}  qx peak on an edge cell: {on_edge}",
+            s.mu_a.unwrap(),
+            s.contact_radius_m * 1e3,
+            s.stick_radius_m * 1e3,
+            s.stick_area_m2 * 1e6,
+            s.p_max_pa / s.hertz_pressure_pa,
+            s.q_max_pa / s.hertz_pressure_pa,
+            s.base_contact
+        );
+        if surface != "flat" {
+            assert!(!s.base_contact, "{surface}: the base plane is touched");
+            assert!(on_edge, "{surface}: qx peaks inside an island");
+        }
+        rows.push((surface, s.mu_a.unwrap(), s.stick_radius_m));
+    }
+    let get = |name: &str| rows.iter().find(|r| r.0 == name).unwrap();
+    for (sparse, dense) in [("circle-A", "circle-B"), ("square-A", "square-B")] {
+        assert!(get(sparse).1 > get(dense).1, "μa({sparse}) > μa({dense})");
+        assert!(
+            get(sparse).2 > get(dense).2,
+            "stick zone narrows with density"
+        );
+    }
+    // The flat surface (density 1) has the narrowest stick zone of all.
+    assert!(rows.iter().all(|r| r.2 >= get("flat").2));
+}
+
+#[test]
+fn centred_square_lattice_mu_a_is_symmetric_about_45_degrees() {
+    let mut cache = KernelCache::new();
+    for surface in ["circle-B", "square-B"] {
+        for (psi, mirror) in [(15.0, 75.0), (30.0, 60.0), (0.0, 90.0)] {
+            let a = solve(&table_1c("Cu", surface, 128, 40.0, psi), &mut cache)
+                .scalars
+                .mu_a
+                .unwrap();
+            let b = solve(&table_1c("Cu", surface, 128, 40.0, mirror), &mut cache)
+                .scalars
+                .mu_a
+                .unwrap();
+            println!("{surface} μa({psi}) = {a:.6}, μa({mirror}) = {b:.6}");
+            assert!((a / b - 1.0).abs() < 0.005);
+        }
+    }
+}
+
+#[test]
+fn hexagonal_lattice_and_stripes_solve_with_equilibrium() {
+    let mut cache = KernelCache::new();
+    let mut spec = table_1c("Cu", "flat", 128, 50.0, 30.0);
+    spec.surface = Surface::Lattice {
+        island: Island::Circle { diameter: 400e-6 },
+        pitch: 700e-6,
+        height: 30e-6,
+        offset: [0.0, 0.0],
+        lattice: LatticeKind::Hexagonal,
+    };
+    let hex = solve(&spec, &mut cache).scalars;
+    spec.surface = Surface::Stripes {
+        width: 300e-6,
+        pitch: 700e-6,
+        height: 30e-6,
+        angle_deg: 90.0,
+        offset: 0.0,
+    };
+    let stripes = solve(&spec, &mut cache).scalars;
+    println!(
+        "hexagonal μa = {:?}, stripes μa = {:?}",
+        hex.mu_a, stripes.mu_a
+    );
+    assert!(!hex.base_contact && !stripes.base_contact);
+}
+
+#[test]
+fn flat_isotropic_mu_a_does_not_depend_on_the_force_direction() {
+    let mut cache = KernelCache::new();
+    let mu: Vec<f64> = [0.0, 30.0, 45.0]
+        .iter()
+        .map(|&psi| {
+            solve(&table_1c("Cu", "flat", 256, 20.0, psi), &mut cache)
+                .scalars
+                .mu_a
+                .unwrap()
+        })
+        .collect();
+    println!("flat Cu μa(0, 30, 45) = {mu:?}");
+    for m in &mu {
+        assert!((m / mu[0] - 1.0).abs() < 0.005);
+    }
+}
+
+#[test]
+fn flat_111_k_e_has_the_crystal_symmetry() {
+    // K_E(ψ) on flat Cu(111): period 120° and mirror ψ → −ψ (x ∥ [1 1 −2]).
+    let mut cache = KernelCache::new();
+    let k_e = |psi: f64, cache: &mut KernelCache| {
+        let spec = table_1c("Cu(111)", "flat", 256, 20.0, psi);
+        let s = solve(&spec, cache).scalars;
+        calibrate_k_e(&s, spec.friction, spec.normal_force_n)
+    };
+    let (k0, k120, k30, km30, k90) = (
+        k_e(0.0, &mut cache),
+        k_e(120.0, &mut cache),
+        k_e(30.0, &mut cache),
+        k_e(-30.0, &mut cache),
+        k_e(90.0, &mut cache),
+    );
+    println!(
+        "Cu(111) K_E(0, 120, 30, -30, 90) = {k0:.5e} {k120:.5e} {k30:.5e} {km30:.5e} {k90:.5e} Pa"
+    );
+    assert!((k0 / k120 - 1.0).abs() < 0.005, "period 120°");
+    assert!((k30 / km30 - 1.0).abs() < 0.005, "mirror about ψ = 0");
+    assert!(
+        (k30 / k90 - 1.0).abs() < 0.005,
+        "30° and 90° are mirror images about 60°"
+    );
+}
