@@ -417,6 +417,13 @@ pub struct CaseOutput {
     pub fields: Fields,
 }
 
+/// How the apparent radii a and c of every result are defined.
+pub const APPARENT_RADIUS_DEFINITION: &str =
+    "radius of the circle with the area of the convex hull of the contact (stick) cells, each cell taken as its full square";
+
+/// How K_E in μa is obtained.
+pub const K_E_DEFINITION: &str = "isotropic: K_E = 8E/(3(1+nu)(2-nu)) (paper Eq. 19); anisotropic: K_E(psi) = mu P (a^2 - c^2)/(delta_F a^3) calibrated on the flat surface of the same material at the same force angle";
+
 /// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)).
 pub fn mu_apparent(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> f64 {
     let (a, c) = (s.contact_radius_m, s.stick_radius_m);

@@ -114,6 +114,10 @@ pub struct RunSummary {
     pub rejected_messages: usize,
     /// Output files that could not be written (plots need fonts).
     pub output_warnings: Vec<String>,
+    /// Definition of the apparent radii a, c used in μa.
+    pub apparent_radius_definition: &'static str,
+    /// How K_E is obtained.
+    pub k_e_definition: &'static str,
 }
 
 fn new_run_id() -> String {
@@ -205,6 +209,8 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         resumed,
         workers: args.workers,
         started_unix_s,
+        apparent_radius_definition: solver::case::APPARENT_RADIUS_DEFINITION,
+        k_e_definition: solver::case::K_E_DEFINITION,
         ..Default::default()
     };
 
