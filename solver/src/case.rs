@@ -221,7 +221,6 @@ pub struct KernelCache {
     ops: HashMap<String, Operator>,
     builds: usize,
     loads: usize,
-    seconds: f64,
     store: Option<Box<dyn KernelStore>>,
 }
 
@@ -247,11 +246,6 @@ impl KernelCache {
     /// Of those, how many came from the persistent store.
     pub fn loads(&self) -> usize {
         self.loads
-    }
-
-    /// Wall time spent making operators resident, s.
-    pub fn seconds(&self) -> f64 {
-        self.seconds
     }
 
     /// The operator for `spec`, built (or loaded) on first use; the second
@@ -283,7 +277,6 @@ impl KernelCache {
                 }
             };
             took = start.elapsed().as_secs_f64();
-            self.seconds += took;
             self.ops.insert(key.clone(), op);
         }
         Ok((self.ops.get_mut(&key).expect("inserted above"), took))

@@ -59,11 +59,6 @@ impl Fft2 {
         }
     }
 
-    /// Padded size `M = 2N`.
-    pub fn padded(&self) -> usize {
-        self.m
-    }
-
     /// Number of complex values of a (half) spectrum.
     pub fn spectrum_len(&self) -> usize {
         self.m * (self.m / 2 + 1)

@@ -58,6 +58,24 @@ pub struct Operator {
     kernels: Vec<Vec<Complex64>>,
     src_spec: Vec<Vec<Complex64>>,
     acc: Vec<Complex64>,
+    tangential_bound: f64,
+}
+
+/// Maximum over frequencies of the largest eigenvalue of the Hermitian part of
+/// the 2x2 tangential symbol of the circulant embedding: an upper bound of the
+/// tangential block's largest eigenvalue.
+fn tangential_symbol_max(kernels: &[Vec<Complex64>]) -> f64 {
+    let (kxx, kxy, kyx, kyy) = (&kernels[0], &kernels[1], &kernels[3], &kernels[4]);
+    let mut best = 0.0_f64;
+    for i in 0..kxx.len() {
+        let a = kxx[i].re;
+        let d = kyy[i].re;
+        let b = 0.5 * (kxy[i] + kyx[i].conj());
+        let mean = 0.5 * (a + d);
+        let disc = (0.25 * (a - d) * (a - d) + b.norm_sqr()).sqrt();
+        best = best.max(mean + disc);
+    }
+    best
 }
 
 impl Operator {
@@ -104,7 +122,7 @@ impl Operator {
     pub fn from_tables(grid: Grid, real: &[Vec<f64>]) -> Self {
         let mut fft = Fft2::new(grid.n);
         let slen = fft.spectrum_len();
-        let kernels = real
+        let kernels: Vec<Vec<Complex64>> = real
             .iter()
             .map(|r| {
                 let mut s = vec![Complex64::default(); slen];
@@ -112,9 +130,11 @@ impl Operator {
                 s
             })
             .collect();
+        let tangential_bound = tangential_symbol_max(&kernels);
         Operator {
             grid,
             fft,
+            tangential_bound,
             kernels,
             src_spec: (0..3).map(|_| vec![Complex64::default(); slen]).collect(),
             acc: vec![Complex64::default(); slen],
@@ -124,11 +144,6 @@ impl Operator {
     /// The grid this operator was built for.
     pub fn grid(&self) -> Grid {
         self.grid
-    }
-
-    /// Bytes held by kernel spectra and work buffers.
-    pub fn resident_bytes(&self) -> usize {
-        (self.kernels.len() + self.src_spec.len() + 1) * self.acc.len() * 16
     }
 
     /// `u_i = Σ_j K_ij * t_j` for the listed source components `src = [(j, t_j)]`
@@ -151,26 +166,10 @@ impl Operator {
         }
     }
 
-    /// Upper bound of the largest eigenvalue of the tangential block (m/Pa):
-    /// the maximum over frequencies of the 2x2 symbol of the circulant embedding.
+    /// Upper bound of the largest eigenvalue of the tangential block (m/Pa),
+    /// computed once at construction (the tangential solver's step is its inverse).
     pub fn tangential_bound(&self) -> f64 {
-        let (kxx, kxy, kyx, kyy) = (
-            &self.kernels[0],
-            &self.kernels[1],
-            &self.kernels[3],
-            &self.kernels[4],
-        );
-        let mut best = 0.0_f64;
-        for i in 0..kxx.len() {
-            // Hermitian part of the 2x2 symbol; its largest eigenvalue.
-            let a = kxx[i].re;
-            let d = kyy[i].re;
-            let b = 0.5 * (kxy[i] + kyx[i].conj());
-            let mean = 0.5 * (a + d);
-            let disc = (0.25 * (a - d) * (a - d) + b.norm_sqr()).sqrt();
-            best = best.max(mean + disc);
-        }
-        best
+        self.tangential_bound
     }
 
     /// Normal displacement under pressure only: `uz = K_zz * p`.
