@@ -12,6 +12,9 @@ use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
+/// Side of the square tiles of the transposes.
+const TILE: usize = 16;
+
 /// FFT plans and scratch for one padded grid size. Build once, apply many times.
 pub struct Fft2 {
     m: usize,
@@ -89,13 +92,21 @@ impl Fft2 {
                 .r2c
                 .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
         }
-        // Transpose into out ([kx][ky]) with zero rows for iy >= nrows.
-        for kx in 0..h {
-            let col = &mut out[kx * m..(kx + 1) * m];
-            for (iy, c) in col[..nrows].iter_mut().enumerate() {
-                *c = self.rows[iy * h + kx];
+        // Transpose into out ([kx][ky]) in cache-sized tiles, with zero rows for iy >= nrows.
+        for kx0 in (0..h).step_by(TILE) {
+            let kx1 = (kx0 + TILE).min(h);
+            for iy0 in (0..nrows).step_by(TILE) {
+                let iy1 = (iy0 + TILE).min(nrows);
+                for kx in kx0..kx1 {
+                    let col = &mut out[kx * m + iy0..kx * m + iy1];
+                    for (c, iy) in col.iter_mut().zip(iy0..iy1) {
+                        *c = self.rows[iy * h + kx];
+                    }
+                }
             }
-            col[nrows..].fill(Complex64::default());
+            for kx in kx0..kx1 {
+                out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
+            }
         }
         self.col_fwd.process_with_scratch(out, &mut self.scratch);
     }
@@ -111,11 +122,21 @@ impl Fft2 {
         self.col_inv.process_with_scratch(spec, &mut self.scratch);
         let scale = 1.0 / (m as f64 * m as f64);
         let mut row_c = std::mem::take(&mut self.rows);
-        for iy in 0..n {
-            let dst = &mut row_c[..h];
-            for (kx, d) in dst.iter_mut().enumerate() {
-                *d = spec[kx * m + iy];
+        // Tiled transpose of the first n rows back to [iy][kx].
+        for kx0 in (0..h).step_by(TILE) {
+            let kx1 = (kx0 + TILE).min(h);
+            for iy0 in (0..n).step_by(TILE) {
+                let iy1 = (iy0 + TILE).min(n);
+                for kx in kx0..kx1 {
+                    let col = &spec[kx * m + iy0..kx * m + iy1];
+                    for (c, iy) in col.iter().zip(iy0..iy1) {
+                        row_c[iy * h + kx] = *c;
+                    }
+                }
             }
+        }
+        for iy in 0..n {
+            let dst = &mut row_c[iy * h..(iy + 1) * h];
             // The imaginary parts of the DC and Nyquist bins are zero up to round-off;
             // realfft would reject them, so clear them explicitly.
             dst[0].im = 0.0;

@@ -13,6 +13,7 @@ pub mod fft2;
 pub mod geometry;
 pub mod influence;
 pub mod material;
+pub mod multilevel;
 pub mod normal;
 pub mod operator;
 pub mod presets;

@@ -4,6 +4,7 @@
 //! caller, e.g. `uz(q)` from tangential coupling); knows nothing of geometry.
 
 use crate::error::SolverError;
+use crate::multilevel::CoarseLevel;
 use crate::operator::Operator;
 
 /// Convergence report of one normal solve.
@@ -21,6 +22,11 @@ pub struct NormalReport {
     pub load_error: f64,
     /// True when `change < tolerance` within the iteration budget.
     pub converged: bool,
+    /// Operator applications on the fine grid.
+    pub applications: usize,
+    /// Iterations on the coarse levels of a nested start (each costs a
+    /// quarter, a sixteenth, … of a fine one).
+    pub coarse_iterations: usize,
 }
 
 /// Solution of a normal problem.
@@ -36,9 +42,185 @@ pub struct NormalSolution {
     pub report: NormalReport,
 }
 
+/// What the Polonsky–Keer iteration needs of an operator: `uz = K_zz * p`.
+trait ZzApply {
+    fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]);
+}
+
+impl ZzApply for Operator {
+    fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
+        self.normal(p, uz);
+    }
+}
+
+impl ZzApply for CoarseLevel {
+    fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
+        self.normal(p, uz);
+    }
+}
+
+/// Default start: a uniform pressure over the cells whose separation is within
+/// the smallest 5 % of the range.
+fn default_start(h: &[f64]) -> Vec<f64> {
+    let hmin = h.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hmax = h.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let cut = hmin + 0.05 * (hmax - hmin);
+    h.iter()
+        .map(|&v| if v <= cut { 1.0 } else { 0.0 })
+        .collect()
+}
+
+/// Iterations after which `u = K p` is recomputed even if it could be updated.
+const REFRESH: usize = 32;
+
+/// The Polonsky–Keer iteration on one grid: `p` (any non-negative start with a
+/// positive sum) is overwritten by the solution; `u` receives `K_zz p`.
+///
+/// One operator application per iteration when the active set did not change:
+/// then `p_new = s (p − τ t)` exactly, and `u_new = s (u − τ K t)` reuses `K t`.
+/// Any clipping or re-admission triggers a fresh `u = K p` next iteration.
+#[allow(clippy::too_many_arguments)]
+fn polonsky_keer(
+    op: &mut impl ZzApply,
+    h: &[f64],
+    da: f64,
+    load_n: f64,
+    tolerance: f64,
+    max_iterations: usize,
+    p: &mut [f64],
+    u: &mut [f64],
+) -> Result<NormalReport, SolverError> {
+    let len = h.len();
+    let sum: f64 = p.iter().sum::<f64>() * da;
+    if sum <= 0.0 || !sum.is_finite() {
+        p.copy_from_slice(&default_start(h));
+        let s: f64 = p.iter().sum::<f64>() * da;
+        p.iter_mut().for_each(|v| *v *= load_n / s);
+    } else {
+        p.iter_mut().for_each(|v| *v *= load_n / sum);
+    }
+    let mut g = vec![0.0; len];
+    let mut t = vec![0.0; len];
+    let mut r = vec![0.0; len];
+    let mut p_old = vec![0.0; len];
+    let mut g_old = 1.0;
+    let mut delta = 0.0;
+    let mut report = NormalReport::default();
+    let mut u_valid = false;
+    let mut since_refresh = 0;
+    for it in 1..=max_iterations {
+        report.iterations = it;
+        if !u_valid || since_refresh >= REFRESH {
+            op.apply_zz(p, u);
+            report.applications += 1;
+            since_refresh = 0;
+        }
+        since_refresh += 1;
+        let mut nc = 0usize;
+        let mut sum_g = 0.0;
+        for i in 0..len {
+            g[i] = u[i] + h[i];
+            if p[i] > 0.0 {
+                nc += 1;
+                sum_g += g[i];
+            }
+        }
+        if nc == 0 {
+            break;
+        }
+        let gbar = sum_g / nc as f64;
+        let mut gg = 0.0;
+        for i in 0..len {
+            g[i] -= gbar;
+            if p[i] > 0.0 {
+                gg += g[i] * g[i];
+            }
+        }
+        for i in 0..len {
+            t[i] = if p[i] > 0.0 {
+                g[i] + delta * (gg / g_old) * t[i]
+            } else {
+                0.0
+            };
+        }
+        g_old = gg;
+        op.apply_zz(&t, &mut r);
+        report.applications += 1;
+        let mut sr = 0.0;
+        for i in 0..len {
+            if p[i] > 0.0 {
+                sr += r[i];
+            }
+        }
+        let rbar = sr / nc as f64;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..len {
+            if p[i] > 0.0 {
+                num += g[i] * t[i];
+                den += (r[i] - rbar) * t[i];
+            }
+        }
+        if den <= 0.0 || !den.is_finite() {
+            break;
+        }
+        let tau = num / den;
+        // Step, clip, and re-admit cells that interpenetrate (overlap set).
+        let mut overlap = false;
+        let mut clipped = false;
+        p_old.copy_from_slice(p);
+        for i in 0..len {
+            let old = p[i];
+            let mut new = if old > 0.0 {
+                let v = old - tau * t[i];
+                if v < 0.0 {
+                    clipped = true;
+                    0.0
+                } else {
+                    v
+                }
+            } else {
+                0.0
+            };
+            if new == 0.0 && g[i] < 0.0 {
+                new = -tau * g[i];
+                overlap = true;
+            }
+            p[i] = new;
+        }
+        delta = if overlap { 0.0 } else { 1.0 };
+        let total: f64 = p.iter().sum::<f64>() * da;
+        if total <= 0.0 || !total.is_finite() {
+            return Err(SolverError::invalid(
+                "solver",
+                "normal solver lost all contact (pressure vanished); check the geometry",
+            ));
+        }
+        let scale = load_n / total;
+        let mut change = 0.0;
+        for i in 0..len {
+            p[i] *= scale;
+            change += (p[i] - p_old[i]).abs();
+        }
+        u_valid = !(clipped || overlap);
+        if u_valid {
+            for i in 0..len {
+                u[i] = scale * (u[i] - tau * r[i]);
+            }
+        }
+        report.change = change * da / load_n;
+        if report.change < tolerance {
+            report.converged = true;
+            break;
+        }
+    }
+    Ok(report)
+}
+
 /// Solves for the pressure under total load `load_n` given the initial
 /// separation `h0` (m, per cell) and an optional extra gap term. `p_init`
-/// warm-starts the iteration when given.
+/// warm-starts the iteration when given; without it, the problem is first
+/// solved on the operator's coarse levels (coarsest first) and each solution,
+/// interpolated, starts the next finer iteration.
 pub fn solve_normal(
     op: &mut Operator,
     h0: &[f64],
@@ -61,119 +243,60 @@ pub fn solve_normal(
         Some(e) => h0.iter().zip(e).map(|(a, b)| a + b).collect(),
         None => h0.to_vec(),
     };
-    // Initial guess: the warm start, or a uniform pressure over the cells whose
-    // separation is within the smallest 1/4 of the range.
+    let mut coarse_iterations = 0;
     let mut p = match p_init {
         Some(p0) if p0.iter().any(|&v| v > 0.0) => p0.to_vec(),
         _ => {
-            let hmin = h.iter().cloned().fold(f64::INFINITY, f64::min);
-            let hmax = h.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            let cut = hmin + 0.05 * (hmax - hmin);
-            h.iter()
-                .map(|&v| if v <= cut { 1.0 } else { 0.0 })
-                .collect()
+            let levels = op.coarse_levels_mut();
+            if levels.is_empty() {
+                default_start(&h)
+            } else {
+                // Separations restricted down the chain, finest first.
+                let mut hs = vec![crate::multilevel::restrict(&h, grid.n)];
+                for l in 1..levels.len() {
+                    let next = crate::multilevel::restrict(&hs[l - 1], levels[l - 1].grid().n);
+                    hs.push(next);
+                }
+                let coarse_tol = tolerance.max(COARSE_TOLERANCE);
+                let mut start: Option<Vec<f64>> = None;
+                for (level, hl) in levels.iter_mut().zip(&hs).rev() {
+                    let g = level.grid();
+                    let mut pl = match start.take() {
+                        Some(v) => v,
+                        None => default_start(hl),
+                    };
+                    let mut ul = vec![0.0; g.len()];
+                    let rep = polonsky_keer(
+                        level,
+                        hl,
+                        g.cell_area(),
+                        load_n,
+                        coarse_tol,
+                        max_iterations,
+                        &mut pl,
+                        &mut ul,
+                    )?;
+                    coarse_iterations += rep.iterations;
+                    let mut up = crate::multilevel::prolong(&pl, g.n);
+                    up.iter_mut().for_each(|v| *v = v.max(0.0));
+                    start = Some(up);
+                }
+                start.unwrap_or_else(|| default_start(&h))
+            }
         }
     };
-    let sum: f64 = p.iter().sum::<f64>() * da;
-    p.iter_mut().for_each(|v| *v *= load_n / sum);
-
     let mut u = vec![0.0; len];
-    let mut g = vec![0.0; len];
-    let mut t = vec![0.0; len];
-    let mut r = vec![0.0; len];
-    let mut g_old = 1.0;
-    let mut delta = 0.0;
-    let mut report = NormalReport::default();
-    let mut gbar = 0.0;
-    for it in 1..=max_iterations {
-        report.iterations = it;
-        op.normal(&p, &mut u);
-        let mut nc = 0usize;
-        let mut sum_g = 0.0;
-        for i in 0..len {
-            g[i] = u[i] + h[i];
-            if p[i] > 0.0 {
-                nc += 1;
-                sum_g += g[i];
-            }
-        }
-        if nc == 0 {
-            break;
-        }
-        gbar = sum_g / nc as f64;
-        let mut gg = 0.0;
-        for i in 0..len {
-            g[i] -= gbar;
-            if p[i] > 0.0 {
-                gg += g[i] * g[i];
-            }
-        }
-        for i in 0..len {
-            t[i] = if p[i] > 0.0 {
-                g[i] + delta * (gg / g_old) * t[i]
-            } else {
-                0.0
-            };
-        }
-        g_old = gg;
-        op.normal(&t, &mut r);
-        let (mut sr, mut cnt) = (0.0, 0usize);
-        for i in 0..len {
-            if p[i] > 0.0 {
-                sr += r[i];
-                cnt += 1;
-            }
-        }
-        let rbar = sr / cnt as f64;
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..len {
-            if p[i] > 0.0 {
-                r[i] -= rbar;
-                num += g[i] * t[i];
-                den += r[i] * t[i];
-            }
-        }
-        if den <= 0.0 || !den.is_finite() {
-            break;
-        }
-        let tau = num / den;
-        let mut change = 0.0;
-        // Step, clip, and re-admit cells that interpenetrate (overlap set).
-        let mut overlap = false;
-        for i in 0..len {
-            let old = p[i];
-            let mut new = if old > 0.0 {
-                (old - tau * t[i]).max(0.0)
-            } else {
-                0.0
-            };
-            if new == 0.0 && g[i] < 0.0 {
-                new = -tau * g[i];
-                overlap = true;
-            }
-            p[i] = new;
-            // store old in r for the change measure
-            r[i] = old;
-        }
-        delta = if overlap { 0.0 } else { 1.0 };
-        let total: f64 = p.iter().sum::<f64>() * da;
-        if total <= 0.0 || !total.is_finite() {
-            return Err(SolverError::invalid(
-                "solver",
-                "normal solver lost all contact (pressure vanished); check the geometry",
-            ));
-        }
-        let scale = load_n / total;
-        for i in 0..len {
-            p[i] *= scale;
-            change += (p[i] - r[i]).abs();
-        }
-        report.change = change * da / load_n;
-        if report.change < tolerance {
-            report.converged = true;
-            break;
-        }
-    }
+    let mut report = polonsky_keer(
+        op,
+        &h,
+        da,
+        load_n,
+        tolerance,
+        max_iterations,
+        &mut p,
+        &mut u,
+    )?;
+    report.coarse_iterations = coarse_iterations;
     // Final state and residuals from the returned pressure.
     op.normal(&p, &mut u);
     let (mut s, mut nc) = (0.0, 0usize);
@@ -183,7 +306,13 @@ pub fn solve_normal(
             nc += 1;
         }
     }
-    let approach = if nc > 0 { s / nc as f64 } else { gbar };
+    if nc == 0 {
+        return Err(SolverError::invalid(
+            "solver",
+            "normal solver lost all contact (pressure vanished); check the geometry",
+        ));
+    }
+    let approach = s / nc as f64;
     let scale = approach.abs().max(f64::MIN_POSITIVE);
     let (mut gap_res, mut pen) = (0.0_f64, 0.0_f64);
     for i in 0..len {
@@ -204,3 +333,6 @@ pub fn solve_normal(
         report,
     })
 }
+
+/// Tolerance of the coarse-level solves (they only provide a start).
+const COARSE_TOLERANCE: f64 = 1e-6;

@@ -7,6 +7,7 @@
 
 use crate::fft2::Fft2;
 use crate::influence::Block;
+use crate::multilevel::{coarse_levels, CoarseLevel};
 use num_complex::Complex64;
 
 /// Displacement / traction component index: x, y (tangential) and z (normal).
@@ -59,6 +60,8 @@ pub struct Operator {
     src_spec: Vec<Vec<Complex64>>,
     acc: Vec<Complex64>,
     tangential_bound: f64,
+    /// Coarse `K_zz` levels for nested initial guesses (finest first).
+    coarse: Vec<CoarseLevel>,
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian part of
@@ -131,10 +134,12 @@ impl Operator {
             })
             .collect();
         let tangential_bound = tangential_symbol_max(&kernels);
+        let coarse = coarse_levels(grid, &real[3 * Z + Z]);
         Operator {
             grid,
             fft,
             tangential_bound,
+            coarse,
             kernels,
             src_spec: (0..3).map(|_| vec![Complex64::default(); slen]).collect(),
             acc: vec![Complex64::default(); slen],
@@ -155,15 +160,37 @@ impl Operator {
             self.fft.forward_padded(t, &mut self.src_spec[k]);
         }
         for (i, u) in dst.iter_mut() {
-            self.acc.fill(Complex64::default());
-            for (k, (j, _)) in src.iter().enumerate() {
-                let kern = &self.kernels[*i * 3 + *j];
-                for ((a, s), kv) in self.acc.iter_mut().zip(&self.src_spec[k]).zip(kern) {
-                    *a += s * kv;
+            // One fused pass per destination: acc = Σ_k K_ij(k) · t̂_j(k).
+            let k = |j: usize| &self.kernels[*i * 3 + j];
+            let s = &self.src_spec;
+            match src {
+                [(j0, _)] => {
+                    for ((a, s0), k0) in self.acc.iter_mut().zip(&s[0]).zip(k(*j0)) {
+                        *a = s0 * k0;
+                    }
+                }
+                [(j0, _), (j1, _)] => {
+                    let it = self.acc.iter_mut().zip(&s[0]).zip(k(*j0));
+                    for (((a, s0), k0), (s1, k1)) in it.zip(s[1].iter().zip(k(*j1))) {
+                        *a = s0 * k0 + s1 * k1;
+                    }
+                }
+                _ => {
+                    self.acc.fill(Complex64::default());
+                    for (c, (j, _)) in src.iter().enumerate() {
+                        for ((a, sv), kv) in self.acc.iter_mut().zip(&s[c]).zip(k(*j)) {
+                            *a += sv * kv;
+                        }
+                    }
                 }
             }
             self.fft.inverse_cropped(&mut self.acc, u);
         }
+    }
+
+    /// The coarse `K_zz` levels below this grid (finest first).
+    pub fn coarse_levels_mut(&mut self) -> &mut [CoarseLevel] {
+        &mut self.coarse
     }
 
     /// Upper bound of the largest eigenvalue of the tangential block (m/Pa),

@@ -1,0 +1,235 @@
+//! Side-by-side benchmark driver (our half of `bench/compare.sh`): the Hertz
+//! problem of paper Table 1a (E = 210 GPa, ν = 0.3, R = 18 mm, P = 20 N,
+//! non-periodic, square domain 4.5 a) at the requested sizes, the FFT-floor
+//! ratio of one iteration, and partial slip (F = 0.6 μP, μ = 0.28571).
+//! Prints one JSON object per line. Setup (kernel construction) is excluded
+//! from the solve times, which are medians of `--reps` runs.
+//!
+//! `cargo run --release -p mpcontact-solver --example compare_hertz -- --sizes 256,512 --reps 3`
+
+use solver::case::{kernel_tables, solve_case, CaseSpec, KernelCache};
+use solver::fft2::Fft2;
+use solver::material::Material;
+use solver::normal::solve_normal;
+use solver::operator::{Grid, Operator};
+use solver::surface::Surface;
+use std::time::Instant;
+
+const E: f64 = 210.0e9;
+const NU: f64 = 0.3;
+const R: f64 = 18.0e-3;
+const P: f64 = 20.0;
+const MU: f64 = 0.28571;
+/// PK change tolerance: 1e-9 leaves a relative L1 pressure error of about 4e-9
+/// against the converged discrete solution (the peers are matched to ~1e-8).
+const TOL: f64 = 1e-9;
+
+fn hertz_radius() -> f64 {
+    let es = E / (1.0 - NU * NU);
+    (3.0 * P * R / (4.0 * es)).cbrt()
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+struct Args {
+    sizes: Vec<usize>,
+    slip_sizes: Vec<usize>,
+    reps: usize,
+    threads: usize,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut a = Args {
+        sizes: vec![256, 512, 1024],
+        slip_sizes: vec![128, 256, 512],
+        reps: 3,
+        threads: 1,
+    };
+    let list = |v: &str| -> Result<Vec<usize>, String> {
+        v.split(',')
+            .filter(|s| !s.is_empty())
+            .map(|s| s.trim().parse().map_err(|e| format!("bad size {s:?}: {e}")))
+            .collect()
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(k) = it.next() {
+        let v = it.next().ok_or_else(|| format!("{k} needs a value"))?;
+        match k.as_str() {
+            "--sizes" => a.sizes = list(&v)?,
+            "--slip-sizes" => a.slip_sizes = list(&v)?,
+            "--reps" => a.reps = v.parse().map_err(|e| format!("--reps: {e}"))?,
+            "--threads" => a.threads = v.parse().map_err(|e| format!("--threads: {e}"))?,
+            other => return Err(format!("unknown option {other}")),
+        }
+    }
+    if a.reps == 0 {
+        return Err("--reps must be at least 1".into());
+    }
+    Ok(a)
+}
+
+fn grid(n: usize) -> Grid {
+    let d = 4.5 * hertz_radius() / n as f64;
+    Grid { n, dx: d, dy: d }
+}
+
+fn gap(g: Grid) -> Vec<f64> {
+    (0..g.len())
+        .map(|i| {
+            let (x, y) = (g.x(i % g.n), g.y(i / g.n));
+            (x * x + y * y) / (2.0 * R)
+        })
+        .collect()
+}
+
+fn hertz(n: usize, args: &Args, op: &mut Operator, nested: bool) {
+    let g = grid(n);
+    let h = gap(g);
+    let a = hertz_radius();
+    let pmax = 3.0 * P / (2.0 * std::f64::consts::PI * a * a);
+    // A non-nested run starts from the default guess through a one-cell warm start
+    // that is replaced at once: pass a uniform pressure over the central cells.
+    let flat_start: Vec<f64> = h
+        .iter()
+        .map(|&v| {
+            if v <= 0.05 * a * a / (2.0 * R) {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..args.reps {
+        let t0 = Instant::now();
+        let sol = solve_normal(
+            op,
+            &h,
+            None,
+            P,
+            TOL,
+            10_000,
+            (!nested).then_some(&flat_start[..]),
+        )
+        .expect("Hertz solve");
+        times.push(t0.elapsed().as_secs_f64());
+        last = Some(sol);
+    }
+    let sol = last.expect("at least one rep");
+    let pm = sol.p.iter().cloned().fold(0.0, f64::max);
+    let nc = sol.p.iter().filter(|&&v| v > 0.0).count() as f64;
+    let radius = (nc * g.cell_area() / std::f64::consts::PI).sqrt();
+    let mode = if nested {
+        "nested coarse-to-fine PK (Galerkin coarse levels)"
+    } else {
+        "plain PK"
+    };
+    println!(
+        "{{\"solver\": \"mpcontact\", \"kind\": \"hertz\", \"mode\": \"{mode}\", \"n\": {n}, \"threads\": {}, \"tol\": {TOL:e}, \"iterations\": {}, \"coarse_iterations\": {}, \"applications\": {}, \"seconds\": {:.6}, \"pmax_err\": {:.3e}, \"radius_err\": {:.3e}, \"converged\": {}, \"ok\": true}}",
+        args.threads,
+        sol.report.iterations,
+        sol.report.coarse_iterations,
+        sol.report.applications + 1,
+        median(times.clone()),
+        pm / pmax - 1.0,
+        radius / a - 1.0,
+        sol.report.converged,
+    );
+    if !nested {
+        // FFT floor of one PK iteration: the transforms of its applications.
+        let mut fft = Fft2::new(n);
+        let mut spec = vec![num_complex::Complex64::default(); fft.spectrum_len()];
+        let mut out = vec![0.0; n * n];
+        let mut pair = Vec::new();
+        for _ in 0..(5 * args.reps).max(5) {
+            let t0 = Instant::now();
+            fft.forward_padded(&sol.p, &mut spec);
+            fft.inverse_cropped(&mut spec, &mut out);
+            pair.push(t0.elapsed().as_secs_f64());
+        }
+        let pair = median(pair);
+        let its = sol.report.iterations as f64;
+        let apps = (sol.report.applications + 1) as f64;
+        let iter_s = median(times) / its;
+        let fft_s = pair * apps / its;
+        println!(
+            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"normal PK iteration\", \"n\": {n}, \"threads\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"ok\": true}}",
+            args.threads,
+            apps / its,
+            iter_s / fft_s
+        );
+    }
+}
+
+fn slip(n: usize, args: &Args, coupling: bool) {
+    let a = hertz_radius();
+    let spec = CaseSpec {
+        material: Material::isotropic("Fe", E, NU).expect("valid"),
+        surface: Surface::Flat,
+        grid_points: n,
+        spacing_m: 4.5 * a / n as f64,
+        indenter_radius_m: R,
+        normal_force_n: P,
+        friction: MU,
+        tangential_ratio: 0.6,
+        angle_deg: 0.0,
+        coupling,
+        tolerance: TOL,
+        tangential_tolerance: 1e-6,
+        max_iterations: 20_000,
+        coupling_tolerance: 1e-8,
+        max_coupling_iterations: 50,
+    };
+    let mut cache = KernelCache::new();
+    let _ = cache.operator(&spec).expect("kernel");
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..args.reps {
+        let out = solve_case(&spec, &mut cache).expect("slip solve");
+        times.push(out.scalars.seconds);
+        last = Some(out);
+    }
+    let out = last.expect("at least one rep");
+    let s = &out.scalars;
+    let da = spec.spacing_m * spec.spacing_m;
+    let contact = out.fields.p.iter().filter(|&&v| v > 0.0).count() as f64 * da;
+    let stick = out.fields.stick.iter().filter(|&&v| v > 0.5).count() as f64 * da;
+    let ca = (stick / contact).sqrt();
+    let exact = (1.0_f64 - 0.6).cbrt();
+    println!(
+        "{{\"solver\": \"mpcontact\", \"kind\": \"slip\", \"mode\": \"{}\", \"n\": {n}, \"threads\": {}, \"tol\": 1e-6, \"iterations\": {}, \"normal_iterations\": {}, \"coupling_iterations\": {}, \"seconds\": {:.6}, \"c_over_a\": {ca:.5}, \"c_over_a_err\": {:.3e}, \"converged\": {}, \"ok\": true}}",
+        if coupling { "coupled (normal-tangential)" } else { "uncoupled (Cattaneo-Mindlin)" },
+        args.threads,
+        s.tangential_iterations,
+        s.normal_iterations,
+        s.coupling_iterations,
+        median(times),
+        ca / exact - 1.0,
+        s.converged,
+    );
+}
+
+fn main() {
+    let args = match parse() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("compare_hertz: {e}");
+            std::process::exit(2);
+        }
+    };
+    let material = Material::isotropic("Fe", E, NU).expect("valid material");
+    for &n in &args.sizes {
+        let g = grid(n);
+        let mut op = Operator::from_tables(g, &kernel_tables(&material, g));
+        hertz(n, &args, &mut op, true);
+        hertz(n, &args, &mut op, false);
+    }
+    for &n in &args.slip_sizes {
+        slip(n, &args, false);
+        slip(n, &args, true);
+    }
+}
