@@ -10,7 +10,7 @@
 use solver::case::{kernel_tables, solve_case, CaseSpec, KernelCache};
 use solver::fft2::Fft2;
 use solver::material::Material;
-use solver::normal::solve_normal;
+use solver::normal::{solve_normal_with, NormalOptions};
 use solver::operator::{Grid, Operator};
 use solver::surface::Surface;
 use std::time::Instant;
@@ -85,37 +85,17 @@ fn gap(g: Grid) -> Vec<f64> {
         .collect()
 }
 
-fn hertz(n: usize, args: &Args, op: &mut Operator, nested: bool) {
+fn hertz(n: usize, args: &Args, op: &mut Operator, options: NormalOptions) {
     let g = grid(n);
     let h = gap(g);
     let a = hertz_radius();
     let pmax = 3.0 * P / (2.0 * std::f64::consts::PI * a * a);
-    // A non-nested run starts from the default guess through a one-cell warm start
-    // that is replaced at once: pass a uniform pressure over the central cells.
-    let flat_start: Vec<f64> = h
-        .iter()
-        .map(|&v| {
-            if v <= 0.05 * a * a / (2.0 * R) {
-                1.0
-            } else {
-                0.0
-            }
-        })
-        .collect();
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..args.reps {
         let t0 = Instant::now();
-        let sol = solve_normal(
-            op,
-            &h,
-            None,
-            P,
-            TOL,
-            10_000,
-            (!nested).then_some(&flat_start[..]),
-        )
-        .expect("Hertz solve");
+        let sol =
+            solve_normal_with(op, &h, None, P, TOL, 10_000, None, options).expect("Hertz solve");
         times.push(t0.elapsed().as_secs_f64());
         last = Some(sol);
     }
@@ -123,10 +103,11 @@ fn hertz(n: usize, args: &Args, op: &mut Operator, nested: bool) {
     let pm = sol.p.iter().cloned().fold(0.0, f64::max);
     let nc = sol.p.iter().filter(|&&v| v > 0.0).count() as f64;
     let radius = (nc * g.cell_area() / std::f64::consts::PI).sqrt();
-    let mode = if nested {
-        "nested coarse-to-fine PK (Galerkin coarse levels)"
-    } else {
-        "plain PK"
+    let mode = match (options.nested, options.precondition) {
+        (true, true) => "nested coarse-to-fine + |k| preconditioned PK",
+        (true, false) => "nested coarse-to-fine PK",
+        (false, true) => "|k| preconditioned PK",
+        (false, false) => "plain PK",
     };
     println!(
         "{{\"solver\": \"mpcontact\", \"kind\": \"hertz\", \"mode\": \"{mode}\", \"n\": {n}, \"threads\": {}, \"tol\": {TOL:e}, \"iterations\": {}, \"coarse_iterations\": {}, \"applications\": {}, \"seconds\": {:.6}, \"pmax_err\": {:.3e}, \"radius_err\": {:.3e}, \"converged\": {}, \"ok\": true}}",
@@ -139,7 +120,7 @@ fn hertz(n: usize, args: &Args, op: &mut Operator, nested: bool) {
         radius / a - 1.0,
         sol.report.converged,
     );
-    if !nested {
+    if !options.nested && !options.precondition {
         // FFT floor of one PK iteration: the transforms of its applications.
         let mut fft = Fft2::new(n);
         let mut spec = vec![num_complex::Complex64::default(); fft.spectrum_len()];
@@ -225,8 +206,13 @@ fn main() {
     for &n in &args.sizes {
         let g = grid(n);
         let mut op = Operator::from_tables(g, &kernel_tables(&material, g));
-        hertz(n, &args, &mut op, true);
-        hertz(n, &args, &mut op, false);
+        for (nested, precondition) in [(true, true), (false, true), (false, false)] {
+            let options = NormalOptions {
+                nested,
+                precondition,
+            };
+            hertz(n, &args, &mut op, options);
+        }
     }
     for &n in &args.slip_sizes {
         slip(n, &args, false);

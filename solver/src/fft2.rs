@@ -31,7 +31,20 @@ pub struct Fft2 {
 impl Fft2 {
     /// Plans for an `n x n` physical grid padded to `2n x 2n`.
     pub fn new(n: usize) -> Self {
-        let m = 2 * n;
+        Self::with_sizes(n, 2 * n)
+    }
+
+    /// Plans for an `n x n` field on an unpadded periodic `n x n` grid.
+    pub fn periodic(n: usize) -> Self {
+        Self::with_sizes(n, n)
+    }
+
+    /// The padded-grid side (`2n`, or `n` for a periodic transform).
+    pub fn padded_len(&self) -> usize {
+        self.m
+    }
+
+    fn with_sizes(n: usize, m: usize) -> Self {
         let mut rp = RealFftPlanner::<f64>::new();
         let r2c = rp.plan_fft_forward(m);
         let c2r = rp.plan_fft_inverse(m);

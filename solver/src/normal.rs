@@ -42,20 +42,46 @@ pub struct NormalSolution {
     pub report: NormalReport,
 }
 
-/// What the Polonsky–Keer iteration needs of an operator: `uz = K_zz * p`.
+/// What the Polonsky–Keer iteration needs of an operator: `uz = K_zz * p`,
+/// and the Fourier preconditioner of its grid.
 trait ZzApply {
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]);
+    fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]);
 }
 
 impl ZzApply for Operator {
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
         self.normal(p, uz);
     }
+    fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
+        self.precond_mut().apply(g, active, z);
+    }
 }
 
 impl ZzApply for CoarseLevel {
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
         self.normal(p, uz);
+    }
+    fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
+        self.precond_mut().apply(g, active, z);
+    }
+}
+
+/// Options of a normal solve (both on by default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NormalOptions {
+    /// Start from the coarse levels when no warm start is given.
+    pub nested: bool,
+    /// Precondition the conjugate gradient with the `|k|` Fourier multiplier.
+    pub precondition: bool,
+}
+
+impl Default for NormalOptions {
+    fn default() -> Self {
+        NormalOptions {
+            nested: true,
+            precondition: true,
+        }
     }
 }
 
@@ -87,6 +113,7 @@ fn polonsky_keer(
     load_n: f64,
     tolerance: f64,
     max_iterations: usize,
+    precondition: bool,
     p: &mut [f64],
     u: &mut [f64],
 ) -> Result<NormalReport, SolverError> {
@@ -103,6 +130,12 @@ fn polonsky_keer(
     let mut t = vec![0.0; len];
     let mut r = vec![0.0; len];
     let mut p_old = vec![0.0; len];
+    let mut z = if precondition {
+        vec![0.0; len]
+    } else {
+        Vec::new()
+    };
+    let mut active = vec![false; len];
     let mut g_old = 1.0;
     let mut delta = 0.0;
     let mut report = NormalReport::default();
@@ -129,16 +162,39 @@ fn polonsky_keer(
             break;
         }
         let gbar = sum_g / nc as f64;
-        let mut gg = 0.0;
-        for i in 0..len {
-            g[i] -= gbar;
-            if p[i] > 0.0 {
-                gg += g[i] * g[i];
-            }
+        for gi in g.iter_mut() {
+            *gi -= gbar;
         }
+        // Search direction: the (preconditioned) residual on the contact cells,
+        // conjugated with the previous direction unless the set changed.
+        let gg = if precondition {
+            for (a, &pi) in active.iter_mut().zip(p.iter()) {
+                *a = pi > 0.0;
+            }
+            op.precondition(&g, &active, &mut z);
+            let mut gz = 0.0;
+            for i in 0..len {
+                if active[i] {
+                    gz += g[i] * z[i];
+                }
+            }
+            gz
+        } else {
+            let mut gg = 0.0;
+            for i in 0..len {
+                if p[i] > 0.0 {
+                    gg += g[i] * g[i];
+                }
+            }
+            gg
+        };
+        if gg <= 0.0 || !gg.is_finite() {
+            break;
+        }
+        let zdir: &[f64] = if precondition { &z } else { &g };
         for i in 0..len {
             t[i] = if p[i] > 0.0 {
-                g[i] + delta * (gg / g_old) * t[i]
+                zdir[i] + delta * (gg / g_old) * t[i]
             } else {
                 0.0
             };
@@ -230,6 +286,30 @@ pub fn solve_normal(
     max_iterations: usize,
     p_init: Option<&[f64]>,
 ) -> Result<NormalSolution, SolverError> {
+    solve_normal_with(
+        op,
+        h0,
+        extra_gap,
+        load_n,
+        tolerance,
+        max_iterations,
+        p_init,
+        NormalOptions::default(),
+    )
+}
+
+/// [`solve_normal`] with explicit [`NormalOptions`].
+#[allow(clippy::too_many_arguments)]
+pub fn solve_normal_with(
+    op: &mut Operator,
+    h0: &[f64],
+    extra_gap: Option<&[f64]>,
+    load_n: f64,
+    tolerance: f64,
+    max_iterations: usize,
+    p_init: Option<&[f64]>,
+    options: NormalOptions,
+) -> Result<NormalSolution, SolverError> {
     let grid = op.grid();
     let len = grid.len();
     let da = grid.cell_area();
@@ -248,7 +328,7 @@ pub fn solve_normal(
         Some(p0) if p0.iter().any(|&v| v > 0.0) => p0.to_vec(),
         _ => {
             let levels = op.coarse_levels_mut();
-            if levels.is_empty() {
+            if levels.is_empty() || !options.nested {
                 default_start(&h)
             } else {
                 // Separations restricted down the chain, finest first.
@@ -273,6 +353,7 @@ pub fn solve_normal(
                         load_n,
                         coarse_tol,
                         max_iterations,
+                        options.precondition,
                         &mut pl,
                         &mut ul,
                     )?;
@@ -293,6 +374,7 @@ pub fn solve_normal(
         load_n,
         tolerance,
         max_iterations,
+        options.precondition,
         &mut p,
         &mut u,
     )?;

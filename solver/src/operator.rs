@@ -7,7 +7,7 @@
 
 use crate::fft2::Fft2;
 use crate::influence::Block;
-use crate::multilevel::{coarse_levels, CoarseLevel};
+use crate::multilevel::{coarse_levels, CoarseLevel, FourierPrecond};
 use num_complex::Complex64;
 
 /// Displacement / traction component index: x, y (tangential) and z (normal).
@@ -62,6 +62,8 @@ pub struct Operator {
     tangential_bound: f64,
     /// Coarse `K_zz` levels for nested initial guesses (finest first).
     coarse: Vec<CoarseLevel>,
+    /// Fourier preconditioner of the normal iteration on this grid.
+    precond: FourierPrecond,
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian part of
@@ -140,6 +142,7 @@ impl Operator {
             fft,
             tangential_bound,
             coarse,
+            precond: FourierPrecond::new(grid),
             kernels,
             src_spec: (0..3).map(|_| vec![Complex64::default(); slen]).collect(),
             acc: vec![Complex64::default(); slen],
@@ -186,6 +189,11 @@ impl Operator {
             }
             self.fft.inverse_cropped(&mut self.acc, u);
         }
+    }
+
+    /// The Fourier preconditioner of the normal iteration.
+    pub fn precond_mut(&mut self) -> &mut FourierPrecond {
+        &mut self.precond
     }
 
     /// The coarse `K_zz` levels below this grid (finest first).

@@ -489,7 +489,9 @@ fn cg_disc(
                 return Ok(out);
             }
         }
-        // Conjugate direction on the stick cells.
+        // Conjugate direction on the stick cells. (A |k| Fourier preconditioner,
+        // which cuts the normal iterations 4x, made this iteration stall: the
+        // slip cells' moves no longer matched the stick cells' steps.)
         let beta = if conj { gg / g_old } else { 0.0 };
         g_old = gg;
         for i in 0..len {
