@@ -167,14 +167,14 @@ def fft_table(rows):
     ok = [r for r in rows if kind(r) == "fft_floor" and r.get("ok", True)]
     if not ok:
         return "(no FFT-floor results)"
-    cells = latest(ok, lambda r: (r.get("n"), r.get("threads")))
-    header = ["N", "threads", "s / iteration", "s / FFT", "iteration ÷ FFT"]
+    cells = latest(ok, lambda r: (r.get("what", ""), r.get("n"), r.get("threads")))
+    header = ["iteration", "N", "threads", "s / iteration", "s / FFT", "iteration ÷ FFT"]
     body = []
-    for r in sorted(cells.values(), key=lambda r: (r.get("n") or 0, str(r.get("threads")))):
+    for r in sorted(cells.values(), key=lambda r: (r.get("what", ""), r.get("n") or 0, str(r.get("threads")))):
         ratio = r.get("ratio")
         if not num(ratio) and num(r.get("iter_seconds")) and num(r.get("fft_seconds")) and r["fft_seconds"] > 0:
             ratio = r["iter_seconds"] / r["fft_seconds"]
-        body.append([f"{r.get('n')}²", r.get("threads", "—"), fs(r.get("iter_seconds")), fs(r.get("fft_seconds")), fr(ratio, 2)])
+        body.append([r.get("what", "—"), f"{r.get('n')}²", r.get("threads", "—"), fs(r.get("iter_seconds")), fs(r.get("fft_seconds")), fr(ratio, 2)])
     return table(header, body)
 
 

@@ -216,7 +216,7 @@ fn default_iter() -> usize {
     5000
 }
 fn default_ctol() -> f64 {
-    1e-8
+    1e-7
 }
 fn default_citer() -> usize {
     50
