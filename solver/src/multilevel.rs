@@ -57,33 +57,29 @@ impl FourierPrecond {
 
     /// `z = Π W Π g` over the cells where `active` is true (`z` is zero elsewhere).
     pub fn apply(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
-        let (mut s, mut c) = (0.0, 0usize);
-        for (gi, &a) in g.iter().zip(active) {
-            if a {
-                s += gi;
-                c += 1;
-            }
-        }
-        let mean = if c > 0 { s / c as f64 } else { 0.0 };
-        for ((f, gi), &a) in self.field.iter_mut().zip(g).zip(active) {
-            *f = if a { gi - mean } else { 0.0 };
-        }
+        centre_on(active, g, &mut self.field);
         self.fft.forward_padded(&self.field, &mut self.spec);
         for (v, w) in self.spec.iter_mut().zip(&self.symbol) {
             *v *= *w;
         }
         self.fft.inverse_cropped(&mut self.spec, z);
-        let (mut s, mut c) = (0.0, 0usize);
-        for (zi, &a) in z.iter().zip(active) {
-            if a {
-                s += zi;
-                c += 1;
-            }
+        self.field.copy_from_slice(z);
+        centre_on(active, &self.field, z);
+    }
+}
+
+/// `Π`: `dst = src − mean_active(src)` on the active cells, zero elsewhere.
+fn centre_on(active: &[bool], src: &[f64], dst: &mut [f64]) {
+    let (mut s, mut c) = (0.0, 0usize);
+    for (v, &a) in src.iter().zip(active) {
+        if a {
+            s += v;
+            c += 1;
         }
-        let mean = if c > 0 { s / c as f64 } else { 0.0 };
-        for (zi, &a) in z.iter_mut().zip(active) {
-            *zi = if a { *zi - mean } else { 0.0 };
-        }
+    }
+    let mean = if c > 0 { s / c as f64 } else { 0.0 };
+    for ((d, v), &a) in dst.iter_mut().zip(src).zip(active) {
+        *d = if a { v - mean } else { 0.0 };
     }
 }
 
