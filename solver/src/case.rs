@@ -572,10 +572,9 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         // passes use the configured tolerances.
         let mut prev_change: f64 = 1e-2;
         let mut anderson = Anderson::new(ANDERSON_DEPTH, len);
-        let mut exact_pass;
         for k in 1..=spec.max_coupling_iterations {
             coupling_iterations = k;
-            exact_pass = !spec.coupling || prev_change < 10.0 * spec.coupling_tolerance;
+            let exact_pass = !spec.coupling || prev_change < 10.0 * spec.coupling_tolerance;
             // In the final passes the tangential residual must not show as a
             // change of p above the coupling tolerance: with the default
             // coupling tolerance the KKT tolerance stays as configured; a

@@ -246,8 +246,8 @@ pub fn solve_tangential(
         &cells,
         &bound,
         target,
-        &mut qx,
-        &mut qy,
+        (&mut qx, &mut qy),
+        (&mut sx, &mut sy),
         &mut lambda,
     )?;
     report.cg_iterations = cg.iterations;
@@ -327,7 +327,10 @@ pub fn solve_tangential(
     };
 
     // Final slip, stick set, shift and KKT residuals of the returned tractions.
-    slip_field(op, &qx, &qy, &mut sx, &mut sy);
+    // A converged CG phase left `s = C q + e` of these tractions in (sx, sy).
+    if !(cg.converged && fista_budget == 0) {
+        slip_field(op, &qx, &qy, &mut sx, &mut sy);
+    }
     let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
     for &i in &cells {
         stick[i] = qx[i].hypot(qy[i]) < stick_tol * bound[i];
@@ -407,13 +410,12 @@ fn cg_disc(
     cells: &[usize],
     bound: &[f64],
     target: [f64; 2],
-    qx: &mut [f64],
-    qy: &mut [f64],
+    (qx, qy): (&mut [f64], &mut [f64]),
+    (ux, uy): (&mut [f64], &mut [f64]),
     lambda: &mut [f64; 2],
 ) -> Result<CgOutcome, SolverError> {
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| qx.hypot(qy) >= (1.0 - 1e-12) * b;
-    let (mut ux, mut uy) = (vec![0.0; len], vec![0.0; len]);
     let (mut tx, mut ty) = (vec![0.0; len], vec![0.0; len]);
     let (mut rx, mut ry) = (vec![0.0; len], vec![0.0; len]);
     let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
@@ -435,7 +437,7 @@ fn cg_disc(
         out.iterations = it;
         if !u_valid {
             out.applications += 1;
-            op.tangential(qx, qy, &mut ux, &mut uy);
+            op.tangential(qx, qy, ux, uy);
             if let Some((ex, ey)) = prob.extra {
                 for i in 0..len {
                     ux[i] += ex[i];
