@@ -5,8 +5,8 @@
 //! Run: `cargo bench -p mpcontact-solver --bench solver`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use solver::case::{kernel_tables, solve_case, CaseSpec, KernelCache};
-use solver::operator::{Grid, Operator, X, Y, Z};
+use solver::case::{build_operator, solve_case, CaseSpec, KernelCache};
+use solver::operator::{Grid, X, Y, Z};
 use solver::surface::Surface;
 
 fn table_1a(n: usize, ratio: f64) -> CaseSpec {
@@ -39,7 +39,7 @@ fn operator_apply(c: &mut Criterion) {
             dy: 1e-6,
         };
         let material = solver::presets::material("Fe").unwrap();
-        let mut op = Operator::from_tables(grid, &kernel_tables(&material, grid));
+        let mut op = build_operator(&material, grid);
         let t: Vec<Vec<f64>> = (0..3)
             .map(|k| (0..n * n).map(|i| ((i * 7 + k) % 13) as f64).collect())
             .collect();
@@ -74,7 +74,7 @@ fn kernel_build(c: &mut Criterion) {
             };
             let material = solver::presets::material(name).unwrap();
             g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
-                b.iter(|| Operator::from_tables(grid, &kernel_tables(&material, grid)))
+                b.iter(|| build_operator(&material, grid))
             });
         }
     }

@@ -7,7 +7,7 @@
 //!
 //! `cargo run --release -p mpcontact-solver --example compare_hertz -- --sizes 256,512 --reps 3`
 
-use solver::case::{kernel_tables, solve_case, CaseSpec, KernelCache};
+use solver::case::{build_operator, solve_case, CaseSpec, KernelCache};
 use solver::fft2::Fft2;
 use solver::material::Material;
 use solver::normal::{solve_normal_with, NormalOptions};
@@ -254,7 +254,7 @@ fn main() {
     let material = Material::isotropic("Fe", E, NU).expect("valid material");
     for &n in &args.sizes {
         let g = grid(n);
-        let mut op = Operator::from_tables(g, &kernel_tables(&material, g));
+        let mut op = build_operator(&material, g);
         for (nested, precondition) in [(true, true), (false, true), (false, false)] {
             let options = NormalOptions {
                 nested,

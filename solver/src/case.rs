@@ -6,9 +6,10 @@
 use crate::error::SolverError;
 use crate::geometry::{equivalent_radius, hull_area};
 use crate::influence::isotropic_cell;
+use crate::influence::Block;
 use crate::material::{Elasticity, Material};
 use crate::normal::{solve_normal, NormalReport};
-use crate::operator::{Grid, Operator, X, Y, Z};
+use crate::operator::{Grid, Operator, Spectra, X, Y, Z};
 use crate::surface::Surface;
 use crate::tangential::{solve_tangential, TangentialProblem, TangentialReport};
 use serde::{Deserialize, Serialize};
@@ -206,13 +207,14 @@ impl CaseSpec {
     }
 }
 
-/// Persistent storage of real-space kernel tables (e.g. files), so that a new
-/// process does not pay an expensive anisotropic kernel build again.
+/// Persistent storage of kernel spectra (e.g. files), so that a new process
+/// does not pay an expensive anisotropic kernel build again.
 pub trait KernelStore {
-    /// The nine tables stored under `key`, if present and of `len` values each.
-    fn load(&self, key: &str, len: usize) -> Option<Vec<Vec<f64>>>;
-    /// Stores the tables under `key` (best effort).
-    fn save(&self, key: &str, tables: &[Vec<f64>]);
+    /// The spectra stored under `key`, if present and of `len` values each
+    /// (see [`Spectra::len_for`]).
+    fn load(&self, key: &str, len: usize) -> Option<Spectra>;
+    /// Stores the spectra under `key` (best effort).
+    fn save(&self, key: &str, spectra: &Spectra);
 }
 
 /// Resident operators, keyed by [`CaseSpec::kernel_key`].
@@ -256,24 +258,24 @@ impl KernelCache {
         if !self.ops.contains_key(&key) {
             let start = std::time::Instant::now();
             let grid = spec.grid();
-            let len = 4 * grid.n * grid.n;
+            let len = Spectra::len_for(grid.n);
             let persistent = !spec.material.is_isotropic();
             let stored = match (&self.store, persistent) {
                 (Some(store), true) => store.load(&key, len),
                 _ => None,
             };
-            let op = match stored {
-                Some(tables) => {
+            let op = match stored.and_then(|s| Operator::from_spectra(grid, s)) {
+                Some(op) => {
                     self.loads += 1;
-                    Operator::from_tables(grid, &tables)
+                    op
                 }
                 None => {
-                    let tables = kernel_tables(&spec.material, grid);
+                    let op = build_operator(&spec.material, grid);
                     if let (Some(store), true) = (&self.store, persistent) {
-                        store.save(&key, &tables);
+                        store.save(&key, op.spectra());
                     }
                     self.builds += 1;
-                    Operator::from_tables(grid, &tables)
+                    op
                 }
             };
             took = start.elapsed().as_secs_f64();
@@ -283,21 +285,34 @@ impl KernelCache {
     }
 }
 
-/// The real-space kernel tables of a material on a grid (see [`Operator::tables`]).
-pub fn kernel_tables(material: &Material, grid: Grid) -> Vec<Vec<f64>> {
+/// The cell-influence function `K(x, y)` of a material on a grid (offsets of
+/// the observation point from the loaded cell).
+fn cell_influence(material: &Material, grid: Grid) -> Box<dyn Fn(f64, f64) -> Block> {
+    let (dx, dy) = (grid.dx, grid.dy);
     match &material.elasticity {
         Elasticity::Isotropic(iso) => {
             let (g, nu) = (iso.shear(), iso.poisson);
-            Operator::tables(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy))
+            Box::new(move |x, y| isotropic_cell(g, nu, x, y, dx, dy))
         }
         Elasticity::Anisotropic(c) => {
             let kernel = crate::aniso::AngularKernel::new(c);
-            Operator::tables(grid, |x, y| {
-                let k = crate::aniso::cell_influence(&kernel, x, y, grid.dx, grid.dy);
+            Box::new(move |x, y| {
+                let k = crate::aniso::cell_influence(&kernel, x, y, dx, dy);
                 std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)]))
             })
         }
     }
+}
+
+/// The operator of a material on a grid, built row by row (see [`Operator::build`]).
+pub fn build_operator(material: &Material, grid: Grid) -> Operator {
+    Operator::build(grid, cell_influence(material, grid))
+}
+
+/// The nine real-space kernel tables of a material on a grid (see
+/// [`Operator::tables`]); for tests and inspection, not needed to solve.
+pub fn kernel_tables(material: &Material, grid: Grid) -> Vec<Vec<f64>> {
+    Operator::tables(grid, cell_influence(material, grid))
 }
 
 /// The scalars of one solved case.
@@ -527,8 +542,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     let n = grid.n;
     let len = grid.len();
     let da = grid.cell_area();
-    let heights = spec.surface.heights(&grid);
-    let h0 = initial_gap(spec, &heights);
+    let h0 = initial_gap(spec, &spec.surface.heights(&grid));
     let load = spec.normal_force_n;
     let tol = spec.tolerance;
 
@@ -540,8 +554,9 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     }
     let mut normal_iterations = normal0.report.iterations;
     let mut normal_report = normal0.report;
-    let mut p = normal0.p.clone();
     let mut approach = normal0.approach;
+    let mut p = normal0.p;
+    drop(normal0.uz);
     let force = spec.tangential_force();
     let fnorm = force[0].hypot(force[1]);
 
@@ -559,12 +574,11 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     let mut coupling_converged = true;
 
     if fnorm > 0.0 {
-        let (mut ux0, mut uy0) = (vec![0.0; len], vec![0.0; len]);
         let (mut ex, mut ey) = (vec![0.0; len], vec![0.0; len]);
         let mut hq = vec![0.0; len];
-        if spec.coupling {
-            op.apply(&[(Z, &normal0.p)], &mut [(X, &mut ux0), (Y, &mut uy0)]);
-        }
+        // The pressure before tangential loading: the coupling term is the
+        // tangential displacement of the pressure's change since then.
+        let p0 = if spec.coupling { p.clone() } else { Vec::new() };
         coupling_converged = !spec.coupling;
         let mut have_q = false;
         // Inexact inner solves while the coupling loop is far from converged:
@@ -594,12 +608,14 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
                 )
             };
             if spec.coupling {
-                op.apply(&[(Z, &p)], &mut [(X, &mut ex), (Y, &mut ey)]);
-                for i in 0..len {
-                    ex[i] -= ux0[i];
-                    ey[i] -= uy0[i];
+                // hq is free until uz(q) is computed below.
+                for ((d, a), b) in hq.iter_mut().zip(&p).zip(&p0) {
+                    *d = a - b;
                 }
+                op.apply(&[(Z, &hq)], &mut [(X, &mut ex), (Y, &mut ey)]);
             }
+            // The previous pass's slip is not an input: free it meanwhile.
+            drop((std::mem::take(&mut sx), std::mem::take(&mut sy)));
             let sol = solve_tangential(
                 op,
                 &TangentialProblem {
@@ -688,6 +704,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     } else {
         [1.0, 0.0]
     };
+    let heights = spec.surface.heights(&grid);
     let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let base_contact = !matches!(spec.surface, crate::surface::Surface::Flat)
         && (0..len).any(|i| contact[i] && heights[i] < top);

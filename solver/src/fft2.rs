@@ -12,7 +12,8 @@ use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
-/// Side of the square tiles of the transposes.
+/// Rows transformed together and moved to (from) the transposed spectrum as
+/// one tile: the tile (`TILE x (M/2 + 1)` complex values) stays in cache.
 const TILE: usize = 16;
 
 /// FFT plans and scratch for one padded grid size. Build once, apply many times.
@@ -24,7 +25,8 @@ pub struct Fft2 {
     col_fwd: Arc<dyn Fft<f64>>,
     col_inv: Arc<dyn Fft<f64>>,
     row_real: Vec<f64>,
-    rows: Vec<Complex64>,
+    /// `TILE` row spectra, `[row][kx]`.
+    tile: Vec<Complex64>,
     scratch: Vec<Complex64>,
 }
 
@@ -70,7 +72,7 @@ impl Fft2 {
             col_fwd,
             col_inv,
             row_real: vec![0.0; m],
-            rows: vec![Complex64::default(); m * h],
+            tile: vec![Complex64::default(); TILE.min(m) * h],
             scratch: vec![Complex64::default(); scratch_len],
         }
     }
@@ -95,75 +97,116 @@ impl Fft2 {
         let h = m / 2 + 1;
         debug_assert_eq!(input.len(), nrows * ncols);
         debug_assert_eq!(out.len(), m * h);
-        // Row transforms of the non-zero rows into `rows` ([iy][kx], h columns).
-        for iy in 0..nrows {
-            self.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
-            self.row_real[ncols..].fill(0.0);
-            let dst = &mut self.rows[iy * h..(iy + 1) * h];
-            // Lengths are fixed by construction, so this cannot fail.
-            let _ = self
-                .r2c
-                .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
-        }
-        // Transpose into out ([kx][ky]) in cache-sized tiles, with zero rows for iy >= nrows.
-        for kx0 in (0..h).step_by(TILE) {
-            let kx1 = (kx0 + TILE).min(h);
-            for iy0 in (0..nrows).step_by(TILE) {
-                let iy1 = (iy0 + TILE).min(nrows);
-                for kx in kx0..kx1 {
-                    let col = &mut out[kx * m + iy0..kx * m + iy1];
-                    for (c, iy) in col.iter_mut().zip(iy0..iy1) {
-                        *c = self.rows[iy * h + kx];
-                    }
+        // Row transforms of the non-zero rows, a tile at a time, each tile
+        // moved into its place in the transposed spectrum ([kx][ky]).
+        for iy0 in (0..nrows).step_by(TILE) {
+            let iy1 = (iy0 + TILE).min(nrows);
+            for (r, iy) in (iy0..iy1).enumerate() {
+                self.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
+                self.row_real[ncols..].fill(0.0);
+                let dst = &mut self.tile[r * h..(r + 1) * h];
+                // Lengths are fixed by construction, so this cannot fail.
+                let _ = self
+                    .r2c
+                    .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
+            }
+            for kx in 0..h {
+                let col = &mut out[kx * m + iy0..kx * m + iy1];
+                for (r, c) in col.iter_mut().enumerate() {
+                    *c = self.tile[r * h + kx];
                 }
             }
-            for kx in kx0..kx1 {
-                out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
-            }
         }
+        // Zero padding rows.
+        for kx in 0..h {
+            out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
+        }
+        self.col_fwd.process_with_scratch(out, &mut self.scratch);
+    }
+
+    /// Row stage of a forward transform of a full `M x M` real array supplied
+    /// one row at a time: transforms row `iy` (`M` values) into its place in
+    /// `out`. After all rows, [`Fft2::forward_columns`] completes the transform.
+    pub fn forward_row_into(&mut self, iy: usize, row: &[f64], out: &mut [Complex64]) {
+        let m = self.m;
+        let h = m / 2 + 1;
+        debug_assert_eq!(row.len(), m);
+        debug_assert_eq!(out.len(), m * h);
+        self.row_real.copy_from_slice(row);
+        let dst = &mut self.tile[..h];
+        // Lengths are fixed by construction, so this cannot fail.
+        let _ = self
+            .r2c
+            .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
+        for (kx, v) in dst.iter().enumerate() {
+            out[kx * m + iy] = *v;
+        }
+    }
+
+    /// Column stage completing the rows given to [`Fft2::forward_row_into`].
+    pub fn forward_columns(&mut self, out: &mut [Complex64]) {
         self.col_fwd.process_with_scratch(out, &mut self.scratch);
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the first
     /// `N x N` block of the real result, scaled by `1/M²`.
     pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        self.inverse_rows(spec, self.n, self.n, out, false);
+    }
+
+    /// [`Fft2::inverse_cropped`] added to `out` instead of overwriting it.
+    pub fn inverse_cropped_add(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        self.inverse_rows(spec, self.n, self.n, out, true);
+    }
+
+    /// Inverse transform of a spectrum (consumed as scratch) into the full
+    /// `M x M` real array, scaled by `1/M²`.
+    pub fn inverse_full(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        self.inverse_rows(spec, self.m, self.m, out, false);
+    }
+
+    fn inverse_rows(
+        &mut self,
+        spec: &mut [Complex64],
+        n: usize,
+        ncols: usize,
+        out: &mut [f64],
+        add: bool,
+    ) {
         let m = self.m;
-        let n = self.n;
         let h = m / 2 + 1;
         debug_assert_eq!(spec.len(), m * h);
-        debug_assert_eq!(out.len(), n * n);
+        debug_assert_eq!(out.len(), n * ncols);
         self.col_inv.process_with_scratch(spec, &mut self.scratch);
         let scale = 1.0 / (m as f64 * m as f64);
-        let mut row_c = std::mem::take(&mut self.rows);
-        // Tiled transpose of the first n rows back to [iy][kx].
-        for kx0 in (0..h).step_by(TILE) {
-            let kx1 = (kx0 + TILE).min(h);
-            for iy0 in (0..n).step_by(TILE) {
-                let iy1 = (iy0 + TILE).min(n);
-                for kx in kx0..kx1 {
-                    let col = &spec[kx * m + iy0..kx * m + iy1];
-                    for (c, iy) in col.iter().zip(iy0..iy1) {
-                        row_c[iy * h + kx] = *c;
-                    }
+        // The first n rows, a tile at a time: gather from the transposed
+        // spectrum, then inverse row transforms.
+        for iy0 in (0..n).step_by(TILE) {
+            let iy1 = (iy0 + TILE).min(n);
+            for kx in 0..h {
+                let col = &spec[kx * m + iy0..kx * m + iy1];
+                for (r, c) in col.iter().enumerate() {
+                    self.tile[r * h + kx] = *c;
+                }
+            }
+            for (r, iy) in (iy0..iy1).enumerate() {
+                let dst = &mut self.tile[r * h..(r + 1) * h];
+                // The imaginary parts of the DC and Nyquist bins are zero up to
+                // round-off; realfft would reject them, so clear them explicitly.
+                dst[0].im = 0.0;
+                dst[h - 1].im = 0.0;
+                let _ = self
+                    .c2r
+                    .process_with_scratch(dst, &mut self.row_real, &mut self.scratch);
+                let row = out[iy * ncols..(iy + 1) * ncols]
+                    .iter_mut()
+                    .zip(&self.row_real[..ncols]);
+                if add {
+                    row.for_each(|(o, v)| *o += v * scale);
+                } else {
+                    row.for_each(|(o, v)| *o = v * scale);
                 }
             }
         }
-        for iy in 0..n {
-            let dst = &mut row_c[iy * h..(iy + 1) * h];
-            // The imaginary parts of the DC and Nyquist bins are zero up to round-off;
-            // realfft would reject them, so clear them explicitly.
-            dst[0].im = 0.0;
-            dst[h - 1].im = 0.0;
-            let _ = self
-                .c2r
-                .process_with_scratch(dst, &mut self.row_real, &mut self.scratch);
-            for (o, r) in out[iy * n..(iy + 1) * n]
-                .iter_mut()
-                .zip(&self.row_real[..n])
-            {
-                *o = r * scale;
-            }
-        }
-        self.rows = row_c;
     }
 }

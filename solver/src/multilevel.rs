@@ -90,7 +90,8 @@ const MIN_COARSE_N: usize = 32;
 pub struct CoarseLevel {
     grid: Grid,
     fft: Fft2,
-    zz: Vec<Complex64>,
+    /// Real spectrum of the (even) coarse `K_zz`.
+    zz: Vec<f64>,
     spec: Vec<Complex64>,
     precond: FourierPrecond,
 }
@@ -154,9 +155,9 @@ pub fn coarse_levels(grid: Grid, zz_table: &[f64]) -> Vec<CoarseLevel> {
             dy: 2.0 * g.dy,
         };
         let mut fft = Fft2::new(g.n);
-        let mut zz = vec![Complex64::default(); fft.spectrum_len()];
-        fft.forward_full(&table, &mut zz);
-        let spec = vec![Complex64::default(); fft.spectrum_len()];
+        let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+        fft.forward_full(&table, &mut spec);
+        let zz = spec.iter().map(|z| z.re).collect();
         levels.push(CoarseLevel {
             grid: g,
             fft,

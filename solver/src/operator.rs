@@ -51,14 +51,110 @@ impl Grid {
     }
 }
 
+/// The kernel spectra an operator holds, on the `2N x 2N` wrap-around grid.
+///
+/// By reciprocity (Betti) the cell-integrated influence coefficients satisfy
+/// `K_ji(r) = K_ij(−r)`, so the spectrum of `K_ji` is the complex conjugate of
+/// that of `K_ij`, and `K_xx`, `K_yy`, `K_zz` (even in `r`) have real spectra:
+/// three real and three complex half spectra describe all nine components.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spectra {
+    /// Real spectra of `K_xx`, `K_yy`, `K_zz` (`M (M/2 + 1)` values each).
+    pub diag: [Vec<f64>; 3],
+    /// Spectra of `K_xy`, `K_xz`, `K_yz`.
+    pub off: [Vec<Complex64>; 3],
+}
+
+impl Spectra {
+    /// Values per spectrum on an `n x n` grid.
+    pub fn len_for(n: usize) -> usize {
+        2 * n * (n + 1)
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.diag.iter().map(|d| d.len() * 8).sum::<usize>()
+            + self.off.iter().map(|o| o.len() * 16).sum::<usize>()
+    }
+
+    fn component(&self, i: usize, j: usize) -> Kr<'_> {
+        match (i, j) {
+            _ if i == j => Kr::Re(&self.diag[i]),
+            (0, 1) => Kr::Cx(&self.off[0]),
+            (0, 2) => Kr::Cx(&self.off[1]),
+            (1, 2) => Kr::Cx(&self.off[2]),
+            (1, 0) => Kr::Cj(&self.off[0]),
+            (2, 0) => Kr::Cj(&self.off[1]),
+            _ => Kr::Cj(&self.off[2]),
+        }
+    }
+}
+
+/// One kernel component's spectrum as stored: real, complex, or the conjugate
+/// of a stored complex one.
+#[derive(Clone, Copy)]
+enum Kr<'a> {
+    Re(&'a [f64]),
+    Cx(&'a [Complex64]),
+    Cj(&'a [Complex64]),
+}
+
+impl Kr<'_> {
+    #[inline(always)]
+    fn at(self, f: usize) -> Complex64 {
+        match self {
+            Kr::Re(v) => Complex64::new(v[f], 0.0),
+            Kr::Cx(v) => v[f],
+            Kr::Cj(v) => v[f].conj(),
+        }
+    }
+}
+
+/// The spectral products of one apply round, in place over the source
+/// spectra: `(w0, w1) ← (Σ_s k[0][s] ŝ, Σ_s k[1][s] ŝ)` for `ns` sources
+/// (`w0`, then `w1`) and `nd` destinations (one or two), one pass.
+fn mix(k: &[[Kr; 2]; 2], ns: usize, nd: usize, w0: &mut [Complex64], w1: &mut [Complex64]) {
+    match (ns, nd) {
+        (1, 1) => match k[0][0] {
+            Kr::Re(k00) => w0.iter_mut().zip(k00).for_each(|(a, k)| *a *= k),
+            k00 => w0.iter_mut().enumerate().for_each(|(f, a)| *a *= k00.at(f)),
+        },
+        (1, _) => {
+            let (k00, k10) = (k[0][0], k[1][0]);
+            for (f, (a, b)) in w0.iter_mut().zip(w1.iter_mut()).enumerate() {
+                *b = *a * k10.at(f);
+                *a *= k00.at(f);
+            }
+        }
+        (_, 1) => {
+            let (k00, k01) = (k[0][0], k[0][1]);
+            for (f, (a, b)) in w0.iter_mut().zip(w1.iter()).enumerate() {
+                *a = *a * k00.at(f) + b * k01.at(f);
+            }
+        }
+        _ => {
+            let [[k00, k01], [k10, k11]] = *k;
+            for (f, (a, b)) in w0.iter_mut().zip(w1.iter_mut()).enumerate() {
+                let (x, y) = (*a, *b);
+                *a = x * k00.at(f) + y * k01.at(f);
+                *b = x * k10.at(f) + y * k11.at(f);
+            }
+        }
+    }
+}
+
+/// The `(i, j)` components stored, in the order of a build: diagonal, then
+/// `xy`, `xz`, `yz`.
+const STORED: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+
 /// Kernel spectra and FFT plans for one material on one grid.
 pub struct Operator {
     grid: Grid,
     fft: Fft2,
-    /// `kernels[i][j]`: half spectrum of K_ij (displacement i per traction j).
-    kernels: Vec<Vec<Complex64>>,
-    src_spec: Vec<Vec<Complex64>>,
-    acc: Vec<Complex64>,
+    spectra: Spectra,
+    /// Two work spectra: the sources of an apply round, overwritten in place
+    /// by the destinations' spectra.
+    work: [Vec<Complex64>; 2],
     tangential_bound: f64,
     /// Coarse `K_zz` levels for nested initial guesses (finest first).
     coarse: Vec<CoarseLevel>,
@@ -66,16 +162,13 @@ pub struct Operator {
     precond: FourierPrecond,
 }
 
-/// Maximum over frequencies of the largest eigenvalue of the Hermitian part of
-/// the 2x2 tangential symbol of the circulant embedding: an upper bound of the
-/// tangential block's largest eigenvalue.
-fn tangential_symbol_max(kernels: &[Vec<Complex64>]) -> f64 {
-    let (kxx, kxy, kyx, kyy) = (&kernels[0], &kernels[1], &kernels[3], &kernels[4]);
+/// Maximum over frequencies of the largest eigenvalue of the Hermitian
+/// 2x2 tangential symbol `[[K_xx, K_xy], [conj K_xy, K_yy]]` of the circulant
+/// embedding: an upper bound of the tangential block's largest eigenvalue.
+fn tangential_symbol_max(s: &Spectra) -> f64 {
+    let (kxx, kyy, kxy) = (&s.diag[X], &s.diag[Y], &s.off[0]);
     let mut best = 0.0_f64;
-    for i in 0..kxx.len() {
-        let a = kxx[i].re;
-        let d = kyy[i].re;
-        let b = 0.5 * (kxy[i] + kyx[i].conj());
+    for ((&a, &d), b) in kxx.iter().zip(kyy).zip(kxy) {
         let mean = 0.5 * (a + d);
         let disc = (0.25 * (a - d) * (a - d) + b.norm_sqr()).sqrt();
         best = best.max(mean + disc);
@@ -83,70 +176,128 @@ fn tangential_symbol_max(kernels: &[Vec<Complex64>]) -> f64 {
     best
 }
 
+/// The kernel values of row `iy` of the `2N x 2N` wrap-around grid
+/// (`blocks[ix]`, zero on the row and column `N` that separate positive
+/// from negative offsets).
+fn kernel_row(grid: Grid, iy: usize, cell: &impl Fn(f64, f64) -> Block, blocks: &mut [Block]) {
+    let n = grid.n;
+    let m = 2 * n;
+    let offset = |i: usize| if i < n { i as f64 } else { i as f64 - m as f64 };
+    for (ix, b) in blocks.iter_mut().enumerate() {
+        *b = if iy == n || ix == n {
+            [[0.0; 3]; 3]
+        } else {
+            cell(offset(ix) * grid.dx, offset(iy) * grid.dy)
+        };
+    }
+}
+
 impl Operator {
-    /// Builds the nine kernel spectra from a cell-influence function
-    /// `cell(x, y) -> K(x, y)` (offsets of the observation point from the loaded cell).
+    /// Builds the kernel spectra from a cell-influence function
+    /// `cell(x, y) -> K(x, y)` (offsets of the observation point from the
+    /// loaded cell), row by row: no real-space table is ever held whole.
     pub fn build(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Self {
-        Self::from_tables(grid, &Self::tables(grid, cell))
+        let n = grid.n;
+        let m = 2 * n;
+        let mut fft = Fft2::new(n);
+        let slen = fft.spectrum_len();
+        let mut full: Vec<Vec<Complex64>> = (0..STORED.len())
+            .map(|_| vec![Complex64::default(); slen])
+            .collect();
+        let mut blocks = vec![[[0.0; 3]; 3]; m];
+        let mut row = vec![0.0; m];
+        for iy in 0..m {
+            kernel_row(grid, iy, &cell, &mut blocks);
+            for (&(i, j), out) in STORED.iter().zip(full.iter_mut()) {
+                for (r, b) in row.iter_mut().zip(&blocks) {
+                    *r = b[i][j];
+                }
+                fft.forward_row_into(iy, &row, out);
+            }
+        }
+        let mut full = full.into_iter();
+        let mut next = || {
+            let mut s = full.next().expect("six components");
+            fft.forward_columns(&mut s);
+            s
+        };
+        let mut real = || next().iter().map(|z| z.re).collect::<Vec<f64>>();
+        let diag = [real(), real(), real()];
+        let off = [next(), next(), next()];
+        Self::with_fft(grid, fft, Spectra { diag, off })
     }
 
     /// The nine real-space kernels on the `2N x 2N` wrap-around grid
-    /// (`tables[3 i + j]`, row-major), the expensive part of a build.
+    /// (`tables[3 i + j]`, row-major), for tests and inspection.
     pub fn tables(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Vec<Vec<f64>> {
-        let n = grid.n;
-        let m = 2 * n;
+        let m = 2 * grid.n;
         let mut real: Vec<Vec<f64>> = (0..9).map(|_| vec![0.0; m * m]).collect();
+        let mut blocks = vec![[[0.0; 3]; 3]; m];
         for iy in 0..m {
-            if iy == n {
-                continue;
-            }
-            let oy = if iy < n {
-                iy as f64
-            } else {
-                iy as f64 - m as f64
-            };
-            for ix in 0..m {
-                if ix == n {
-                    continue;
-                }
-                let ox = if ix < n {
-                    ix as f64
-                } else {
-                    ix as f64 - m as f64
-                };
-                let k = cell(ox * grid.dx, oy * grid.dy);
-                for (c, arr) in real.iter_mut().enumerate() {
-                    arr[iy * m + ix] = k[c / 3][c % 3];
+            kernel_row(grid, iy, &cell, &mut blocks);
+            for (c, arr) in real.iter_mut().enumerate() {
+                for (v, b) in arr[iy * m..(iy + 1) * m].iter_mut().zip(&blocks) {
+                    *v = b[c / 3][c % 3];
                 }
             }
         }
         real
     }
 
-    /// Builds the operator from the real-space kernels of [`Operator::tables`].
+    /// Builds the operator from the nine real-space kernels of
+    /// [`Operator::tables`] (only `xx, yy, zz, xy, xz, yz` are used; the
+    /// others follow by reciprocity).
     pub fn from_tables(grid: Grid, real: &[Vec<f64>]) -> Self {
         let mut fft = Fft2::new(grid.n);
         let slen = fft.spectrum_len();
-        let kernels: Vec<Vec<Complex64>> = real
+        let mut spectrum = |i: usize, j: usize| {
+            let mut s = vec![Complex64::default(); slen];
+            fft.forward_full(&real[3 * i + j], &mut s);
+            s
+        };
+        let mut real_part = |i: usize| spectrum(i, i).iter().map(|z| z.re).collect();
+        let diag = [real_part(X), real_part(Y), real_part(Z)];
+        let off = [spectrum(X, Y), spectrum(X, Z), spectrum(Y, Z)];
+        Self::with_fft(grid, fft, Spectra { diag, off })
+    }
+
+    /// An operator holding `spectra` (e.g. loaded from a store); `None` when
+    /// their lengths do not fit the grid.
+    pub fn from_spectra(grid: Grid, spectra: Spectra) -> Option<Self> {
+        let len = Spectra::len_for(grid.n);
+        let fits = spectra.diag.iter().all(|d| d.len() == len)
+            && spectra.off.iter().all(|o| o.len() == len);
+        fits.then(|| Self::with_fft(grid, Fft2::new(grid.n), spectra))
+    }
+
+    fn with_fft(grid: Grid, mut fft: Fft2, spectra: Spectra) -> Self {
+        let slen = fft.spectrum_len();
+        let tangential_bound = tangential_symbol_max(&spectra);
+        // The real K_zz table, transiently, for the Galerkin coarse levels.
+        let mut zz: Vec<Complex64> = spectra.diag[Z]
             .iter()
-            .map(|r| {
-                let mut s = vec![Complex64::default(); slen];
-                fft.forward_full(r, &mut s);
-                s
-            })
+            .map(|&v| Complex64::new(v, 0.0))
             .collect();
-        let tangential_bound = tangential_symbol_max(&kernels);
-        let coarse = coarse_levels(grid, &real[3 * Z + Z]);
+        let m = fft.padded_len();
+        let mut table = vec![0.0; m * m];
+        fft.inverse_full(&mut zz, &mut table);
+        drop(zz);
+        let coarse = coarse_levels(grid, &table);
+        drop(table);
         Operator {
             grid,
             fft,
+            spectra,
+            work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
             tangential_bound,
             coarse,
             precond: FourierPrecond::new(grid),
-            kernels,
-            src_spec: (0..3).map(|_| vec![Complex64::default(); slen]).collect(),
-            acc: vec![Complex64::default(); slen],
         }
+    }
+
+    /// The kernel spectra held (what a kernel store persists).
+    pub fn spectra(&self) -> &Spectra {
+        &self.spectra
     }
 
     /// The grid this operator was built for.
@@ -155,39 +306,39 @@ impl Operator {
     }
 
     /// `u_i = Σ_j K_ij * t_j` for the listed source components `src = [(j, t_j)]`
-    /// and destination components `dst = [(i, u_i)]` (each `n x n`, row-major `[iy][ix]`).
-    /// Destinations are overwritten.
+    /// and destination components `dst = [(i, u_i)]` (each `n x n`, row-major
+    /// `[iy][ix]`, at most three of each). Destinations are overwritten.
     pub fn apply(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])]) {
-        debug_assert!(src.len() <= 3);
-        for (k, (_, t)) in src.iter().enumerate() {
-            self.fft.forward_padded(t, &mut self.src_spec[k]);
-        }
-        for (i, u) in dst.iter_mut() {
-            // One fused pass per destination: acc = Σ_k K_ij(k) · t̂_j(k).
-            let k = |j: usize| &self.kernels[*i * 3 + j];
-            let s = &self.src_spec;
-            match src {
-                [(j0, _)] => {
-                    for ((a, s0), k0) in self.acc.iter_mut().zip(&s[0]).zip(k(*j0)) {
-                        *a = s0 * k0;
-                    }
-                }
-                [(j0, _), (j1, _)] => {
-                    let it = self.acc.iter_mut().zip(&s[0]).zip(k(*j0));
-                    for (((a, s0), k0), (s1, k1)) in it.zip(s[1].iter().zip(k(*j1))) {
-                        *a = s0 * k0 + s1 * k1;
-                    }
-                }
-                _ => {
-                    self.acc.fill(Complex64::default());
-                    for (c, (j, _)) in src.iter().enumerate() {
-                        for ((a, sv), kv) in self.acc.iter_mut().zip(&s[c]).zip(k(*j)) {
-                            *a += sv * kv;
-                        }
-                    }
-                }
+        assert!(src.len() <= 3 && dst.len() <= 3, "at most three components");
+        // Rounds of at most two sources and two destinations; a third source
+        // is added by a second round, a third destination costs its sources'
+        // transforms again (only the final displacements of a case need either).
+        for (r, s) in src.chunks(2).enumerate() {
+            for d in dst.chunks_mut(2) {
+                self.round(s, d, r > 0);
             }
-            self.fft.inverse_cropped(&mut self.acc, u);
+        }
+    }
+
+    /// `u_i (+)= Σ_j K_ij * t_j` for one or two sources and destinations.
+    fn round(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])], add: bool) {
+        let [w0, w1] = &mut self.work;
+        for ((_, t), w) in src.iter().zip([&mut *w0, &mut *w1]) {
+            self.fft.forward_padded(t, w);
+        }
+        let mut k = [[Kr::Re(&[]); 2]; 2];
+        for (kd, (i, _)) in k.iter_mut().zip(dst.iter()) {
+            for (kds, &(j, _)) in kd.iter_mut().zip(src) {
+                *kds = self.spectra.component(*i, j);
+            }
+        }
+        mix(&k, src.len(), dst.len(), w0, w1);
+        for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
+            if add {
+                self.fft.inverse_cropped_add(w, u);
+            } else {
+                self.fft.inverse_cropped(w, u);
+            }
         }
     }
 
@@ -285,5 +436,166 @@ mod tests {
             max_err < 1e-12 * max_val,
             "max err {max_err:e} vs {max_val:e}"
         );
+    }
+
+    /// Direct summation of `u_a = Σ_b K_ab * t_b` with the cell function.
+    fn direct(grid: Grid, cell: &impl Fn(f64, f64) -> Block, t: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let n = grid.n;
+        let mut u = vec![vec![0.0; n * n]; 3];
+        for iy in 0..n {
+            for ix in 0..n {
+                for jy in 0..n {
+                    for jx in 0..n {
+                        let k = cell(
+                            (ix as f64 - jx as f64) * grid.dx,
+                            (iy as f64 - jy as f64) * grid.dy,
+                        );
+                        for (a, ua) in u.iter_mut().enumerate() {
+                            for (b, tb) in t.iter().enumerate() {
+                                ua[iy * n + ix] += k[a][b] * tb[jy * n + jx];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        u
+    }
+
+    fn max_abs(v: &[f64]) -> f64 {
+        v.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+
+    fn cu111_cell(grid: Grid) -> impl Fn(f64, f64) -> Block {
+        let c = crate::presets::material("Cu(111)").unwrap().stiffness();
+        let kernel = crate::aniso::AngularKernel::new(&c);
+        move |x, y| {
+            let k = crate::aniso::cell_influence(&kernel, x, y, grid.dx, grid.dy);
+            std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)]))
+        }
+    }
+
+    #[test]
+    fn influence_tables_are_reciprocal_for_isotropic_and_111_crystals() {
+        // Betti: K_ji(r) = K_ij(−r); on the wrap-around grid −r is index m − i.
+        let grid = Grid {
+            n: 12,
+            dx: 20e-6,
+            dy: 20e-6,
+        };
+        let iso = |x: f64, y: f64| isotropic_cell(48.0e9, 0.34, x, y, grid.dx, grid.dy);
+        for tables in [
+            Operator::tables(grid, iso),
+            Operator::tables(grid, cu111_cell(grid)),
+        ] {
+            let m = 2 * grid.n;
+            let scale = tables.iter().map(|t| max_abs(t)).fold(0.0, f64::max);
+            let neg = |i: usize| (m - i) % m;
+            let mut worst: f64 = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    for iy in 0..m {
+                        for ix in 0..m {
+                            let a = tables[3 * i + j][iy * m + ix];
+                            let b = tables[3 * j + i][neg(iy) * m + neg(ix)];
+                            worst = worst.max((a - b).abs());
+                        }
+                    }
+                }
+            }
+            assert!(
+                worst < 1e-12 * scale,
+                "reciprocity violated by {worst:e} of {scale:e}"
+            );
+            // The off-diagonal couplings are not trivially zero.
+            assert!(max_abs(&tables[1]) > 1e-3 * scale || max_abs(&tables[2]) > 1e-3 * scale);
+        }
+    }
+
+    #[test]
+    fn row_by_row_build_equals_the_table_build() {
+        let grid = Grid {
+            n: 10,
+            dx: 20e-6,
+            dy: 20e-6,
+        };
+        let cell = cu111_cell(grid);
+        let a = Operator::build(grid, &cell);
+        let b = Operator::from_tables(grid, &Operator::tables(grid, &cell));
+        let scale = a.spectra().diag[Z]
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (x, y) in a.spectra().diag.iter().zip(&b.spectra().diag) {
+            for (u, v) in x.iter().zip(y) {
+                assert!((u - v).abs() < 1e-13 * scale);
+            }
+        }
+        for (x, y) in a.spectra().off.iter().zip(&b.spectra().off) {
+            for (u, v) in x.iter().zip(y) {
+                assert!((u - v).norm() < 1e-13 * scale);
+            }
+        }
+        assert_eq!(a.spectra().bytes(), 9 * Spectra::len_for(grid.n) * 8);
+    }
+
+    #[test]
+    fn anisotropic_apply_equals_direct_summation_on_every_path() {
+        // The reciprocal storage (K_yx from K_xy etc.) and each apply path
+        // (1, 2 or 3 sources; 1, 2 or 3 destinations) against direct sums.
+        let grid = Grid {
+            n: 12,
+            dx: 20e-6,
+            dy: 25e-6,
+        };
+        let cell = cu111_cell(grid);
+        let mut op = Operator::build(grid, &cell);
+        let n = grid.n;
+        let t: Vec<Vec<f64>> = (0..3)
+            .map(|c| pseudo_random(n * n, 11 + c as u64))
+            .collect();
+        let zero = vec![0.0; n * n];
+        let only = |keep: &[usize]| -> Vec<Vec<f64>> {
+            (0..3)
+                .map(|c| {
+                    if keep.contains(&c) {
+                        t[c].clone()
+                    } else {
+                        zero.clone()
+                    }
+                })
+                .collect()
+        };
+        let check = |got: &[f64], want: &[f64], what: &str| {
+            let scale = max_abs(want);
+            let err = got
+                .iter()
+                .zip(want)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(err < 1e-12 * scale, "{what}: err {err:e} of {scale:e}");
+        };
+        // Three sources to three destinations.
+        let want = direct(grid, &cell, &t);
+        let (mut ux, mut uy, mut uz) = (zero.clone(), zero.clone(), zero.clone());
+        op.apply(
+            &[(X, &t[0]), (Y, &t[1]), (Z, &t[2])],
+            &mut [(X, &mut ux), (Y, &mut uy), (Z, &mut uz)],
+        );
+        check(&ux, &want[0], "3->x");
+        check(&uy, &want[1], "3->y");
+        check(&uz, &want[2], "3->z");
+        // Tangential (two sources, two destinations, fused).
+        let want = direct(grid, &cell, &only(&[X, Y]));
+        op.tangential(&t[0], &t[1], &mut ux, &mut uy);
+        check(&ux, &want[0], "xy->x");
+        check(&uy, &want[1], "xy->y");
+        op.apply(&[(X, &t[0]), (Y, &t[1])], &mut [(Z, &mut uz)]);
+        check(&uz, &want[2], "xy->z");
+        // Pressure to every component.
+        let want = direct(grid, &cell, &only(&[Z]));
+        op.apply(&[(Z, &t[2])], &mut [(X, &mut ux), (Y, &mut uy)]);
+        check(&ux, &want[0], "z->x");
+        check(&uy, &want[1], "z->y");
+        op.normal(&t[2], &mut uz);
+        check(&uz, &want[2], "z->z");
     }
 }

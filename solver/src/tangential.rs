@@ -220,8 +220,6 @@ pub fn solve_tangential(
     .ok_or_else(gross)?;
 
     let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
-    let (mut yx, mut yy) = (qx.clone(), qy.clone());
-    let (mut px, mut py) = (vec![0.0; len], vec![0.0; len]);
     let mut stick = vec![false; len];
     let mut report = TangentialReport::default();
     let stick_tol = 1.0 - 1e-9;
@@ -248,6 +246,7 @@ pub fn solve_tangential(
         target,
         (&mut qx, &mut qy),
         (&mut sx, &mut sy),
+        (&mut zx, &mut zy),
         &mut lambda,
     )?;
     report.cg_iterations = cg.iterations;
@@ -257,8 +256,6 @@ pub fn solve_tangential(
     if cg.converged {
         report.converged = true;
     }
-    yx.copy_from_slice(&qx);
-    yy.copy_from_slice(&qy);
     // λ of the FISTA projection is step · δt.
     lambda = [cg.shift[0] * step, cg.shift[1] * step];
     let fista_budget = if report.converged {
@@ -266,6 +263,13 @@ pub fn solve_tangential(
     } else {
         prob.max_iterations.saturating_sub(cg.iterations)
     };
+    // FISTA's work fields exist only when it runs.
+    let (mut yx, mut yy) = (Vec::new(), Vec::new());
+    let (mut px, mut py) = (Vec::new(), Vec::new());
+    if fista_budget > 0 {
+        (yx, yy) = (qx.clone(), qy.clone());
+        (px, py) = (vec![0.0; len], vec![0.0; len]);
+    }
 
     // Accelerated projected gradient (FISTA) with gradient-based adaptive restart
     // (O'Donoghue & Candès 2015) on min ½qᵀCq + eᵀq over {discs} ∩ {force}.
@@ -412,13 +416,13 @@ fn cg_disc(
     target: [f64; 2],
     (qx, qy): (&mut [f64], &mut [f64]),
     (ux, uy): (&mut [f64], &mut [f64]),
+    (zx, zy): (&mut [f64], &mut [f64]),
     lambda: &mut [f64; 2],
 ) -> Result<CgOutcome, SolverError> {
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| qx.hypot(qy) >= (1.0 - 1e-12) * b;
     let (mut tx, mut ty) = (vec![0.0; len], vec![0.0; len]);
     let (mut rx, mut ry) = (vec![0.0; len], vec![0.0; len]);
-    let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
     let mut stick = vec![false; len];
     let mut g_old = 1.0;
     let mut conj = false;
@@ -544,7 +548,7 @@ fn cg_disc(
         // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
         let mut l = [0.0; 2];
         project(
-            (&zx, &zy),
+            (&*zx, &*zy),
             bound,
             cells,
             target,

@@ -1,16 +1,22 @@
-//! On-disk store of real-space kernel tables, keyed by material constants and
-//! grid, so a second run (or a second worker) does not pay an anisotropic
-//! kernel build again. Files live in `$MPCONTACT_CACHE_DIR`, else
+//! On-disk store of kernel spectra (the three real and three complex half
+//! spectra an operator holds), keyed by material constants and grid, so a
+//! second run (or a second worker) does not pay an anisotropic kernel build
+//! again. Files live in `$MPCONTACT_CACHE_DIR`, else
 //! `$XDG_CACHE_HOME/mpcontact/kernels`, else `~/.cache/mpcontact/kernels`.
 //! A file that does not match its key exactly is ignored and rewritten.
 
+use num_complex::Complex64;
 use solver::case::KernelStore;
+use solver::operator::Spectra;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-const MAGIC: &[u8; 8] = b"MPCKERN1";
+const MAGIC: &[u8; 8] = b"MPCKERN2";
 
-/// Kernel tables as files in one directory.
+/// Values read per chunk.
+const CHUNK: usize = 1 << 16;
+
+/// Kernel spectra as files in one directory.
 pub struct FileStore {
     dir: PathBuf,
 }
@@ -50,7 +56,7 @@ impl FileStore {
         self.dir.join(format!("{h:016x}.kern"))
     }
 
-    fn read(path: &Path, key: &str, len: usize) -> std::io::Result<Option<Vec<Vec<f64>>>> {
+    fn read(path: &Path, key: &str, len: usize) -> std::io::Result<Option<Spectra>> {
         let mut f = std::io::BufReader::new(std::fs::File::open(path)?);
         let mut magic = [0u8; 8];
         f.read_exact(&mut magic)?;
@@ -66,33 +72,54 @@ impl FileStore {
         if kbytes != key.as_bytes() || u64::from_le_bytes(word) as usize != len {
             return Ok(None);
         }
-        let mut tables = Vec::with_capacity(9);
-        let mut buf = vec![0u8; len * 8];
-        for _ in 0..9 {
-            f.read_exact(&mut buf)?;
-            let t: Vec<f64> = buf
-                .chunks_exact(8)
-                .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-                .collect();
-            if t.iter().any(|v| !v.is_finite()) {
+        let mut buf = vec![0u8; CHUNK * 8];
+        // Reads `out.len()` finite values, chunk by chunk (no whole-file buffer).
+        let mut read_values = |out: &mut [f64]| -> std::io::Result<bool> {
+            for part in out.chunks_mut(CHUNK) {
+                let bytes = &mut buf[..part.len() * 8];
+                f.read_exact(bytes)?;
+                for (v, c) in part.iter_mut().zip(bytes.chunks_exact(8)) {
+                    *v = f64::from_le_bytes(c.try_into().expect("8 bytes"));
+                }
+                if part.iter().any(|v| !v.is_finite()) {
+                    return Ok(false);
+                }
+            }
+            Ok(true)
+        };
+        let mut diag: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; len]);
+        for d in diag.iter_mut() {
+            if !read_values(d)? {
                 return Ok(None);
             }
-            tables.push(t);
+        }
+        let mut off: [Vec<Complex64>; 3] = std::array::from_fn(|_| vec![Complex64::default(); len]);
+        let mut pair = [0.0; 2 * 4096];
+        for o in off.iter_mut() {
+            for part in o.chunks_mut(4096) {
+                let vals = &mut pair[..2 * part.len()];
+                if !read_values(vals)? {
+                    return Ok(None);
+                }
+                for (z, v) in part.iter_mut().zip(vals.chunks_exact(2)) {
+                    *z = Complex64::new(v[0], v[1]);
+                }
+            }
         }
         // Nothing may follow: a longer file is not this entry.
         if f.read(&mut word)? != 0 {
             return Ok(None);
         }
-        Ok(Some(tables))
+        Ok(Some(Spectra { diag, off }))
     }
 }
 
 impl KernelStore for FileStore {
-    fn load(&self, key: &str, len: usize) -> Option<Vec<Vec<f64>>> {
+    fn load(&self, key: &str, len: usize) -> Option<Spectra> {
         Self::read(&self.path(key), key, len).ok().flatten()
     }
 
-    fn save(&self, key: &str, tables: &[Vec<f64>]) {
+    fn save(&self, key: &str, spectra: &Spectra) {
         let write = || -> std::io::Result<()> {
             std::fs::create_dir_all(&self.dir)?;
             let path = self.path(key);
@@ -103,10 +130,16 @@ impl KernelStore for FileStore {
                 f.write_all(MAGIC)?;
                 f.write_all(&(key.len() as u64).to_le_bytes())?;
                 f.write_all(key.as_bytes())?;
-                f.write_all(&(tables.first().map_or(0, |t| t.len()) as u64).to_le_bytes())?;
-                for t in tables {
-                    for v in t {
+                f.write_all(&(spectra.diag[0].len() as u64).to_le_bytes())?;
+                for d in &spectra.diag {
+                    for v in d {
                         f.write_all(&v.to_le_bytes())?;
+                    }
+                }
+                for o in &spectra.off {
+                    for z in o {
+                        f.write_all(&z.re.to_le_bytes())?;
+                        f.write_all(&z.im.to_le_bytes())?;
                     }
                 }
                 f.flush()?;
