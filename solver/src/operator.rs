@@ -132,6 +132,18 @@ fn mix(k: &[[Kr; 2]; 2], ns: usize, nd: usize, w0: &mut [Complex64], w1: &mut [C
                 *a = *a * k00.at(f) + b * k01.at(f);
             }
         }
+        _ if matches!(k, [[Kr::Re(_), Kr::Cx(_)], [Kr::Cj(_), Kr::Re(_)]]) => {
+            // The symmetric blocks (tangential xx/xy/yy): `k10 = conj(k01)`.
+            let [[Kr::Re(k00), Kr::Cx(k01)], [_, Kr::Re(k11)]] = *k else {
+                unreachable!("matched above")
+            };
+            let it = w0.iter_mut().zip(w1.iter_mut());
+            for ((a, b), ((&d0, &d1), &c)) in it.zip(k00.iter().zip(k11).zip(k01)) {
+                let (x, y) = (*a, *b);
+                *a = x * d0 + y * c;
+                *b = x * c.conj() + y * d1;
+            }
+        }
         _ => {
             let [[k00, k01], [k10, k11]] = *k;
             for (f, (a, b)) in w0.iter_mut().zip(w1.iter_mut()).enumerate() {
@@ -340,6 +352,36 @@ impl Operator {
                 self.fft.inverse_cropped(w, u);
             }
         }
+    }
+
+    /// The elastic energy product `⟨t, K t⟩ = Σ_cells t · (K t)` of a shear
+    /// field `t = (tx, ty)`, from its spectra by Parseval: two forward
+    /// transforms and no inverse (`t` is zero outside the grid, so the sum
+    /// over the padded grid is the sum over the cells).
+    pub fn tangential_energy(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
+        let [w0, w1] = &mut self.work;
+        self.fft.forward_padded(tx, w0);
+        self.fft.forward_padded(ty, w1);
+        let m = self.fft.padded_len();
+        let (kxx, kyy, kxy) = (
+            &self.spectra.diag[X],
+            &self.spectra.diag[Y],
+            &self.spectra.off[0],
+        );
+        let mut sum = 0.0;
+        for (kx, col) in (0..m / 2 + 1).map(|kx| (kx, kx * m..(kx + 1) * m)) {
+            // A half spectrum: columns 0 < kx < M/2 stand for their mirror too.
+            let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
+            let mut part = 0.0;
+            for f in col {
+                let (a, b) = (w0[f], w1[f]);
+                part += kxx[f] * a.norm_sqr()
+                    + kyy[f] * b.norm_sqr()
+                    + 2.0 * (a.conj() * kxy[f] * b).re;
+            }
+            sum += weight * part;
+        }
+        sum / (m as f64 * m as f64)
     }
 
     /// The Fourier preconditioner of the normal iteration.
@@ -590,6 +632,15 @@ mod tests {
         check(&uy, &want[1], "xy->y");
         op.apply(&[(X, &t[0]), (Y, &t[1])], &mut [(Z, &mut uz)]);
         check(&uz, &want[2], "xy->z");
+        // The energy product by Parseval equals t · (K t) in real space.
+        let direct_energy: f64 = (0..n * n)
+            .map(|i| t[0][i] * want[0][i] + t[1][i] * want[1][i])
+            .sum();
+        let energy = op.tangential_energy(&t[0], &t[1]);
+        assert!(
+            (energy - direct_energy).abs() < 1e-12 * direct_energy.abs(),
+            "energy {energy:e} vs {direct_energy:e}"
+        );
         // Pressure to every component.
         let want = direct(grid, &cell, &only(&[Z]));
         op.apply(&[(Z, &t[2])], &mut [(X, &mut ux), (Y, &mut uy)]);
