@@ -739,6 +739,23 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         kernel_seconds,
     };
     if fnorm > 0.0 {
+        if c >= a {
+            let slipping = contact_area - stick_area;
+            return Err(SolverError::SlipUnresolved {
+                detail: if slipping > 0.0 {
+                    format!(
+                        "the {} slipping cells lie inside the stick zone's outline, so a = c = {a:.4e} m",
+                        (slipping / da).round()
+                    )
+                } else {
+                    format!(
+                        "all {} contact cells stick under F = {:.4e} N, so a = c = {a:.4e} m",
+                        (contact_area / da).round(),
+                        fnorm
+                    )
+                },
+            });
+        }
         s.mu_a = Some(mu_apparent(&s, load, s.k_e));
     }
     let fields = Fields {

@@ -19,6 +19,13 @@ pub enum SolverError {
         /// Which zone touches the boundary.
         detail: String,
     },
+    /// The grid does not resolve the slip zone: no part of the contact's
+    /// outline slips, so a = c and μa (Eq. 19) is undefined.
+    #[error("the slip zone is not resolved ({detail}); refine grid.spacing_um (more cells across the contact)")]
+    SlipUnresolved {
+        /// What was found.
+        detail: String,
+    },
     /// The whole contact slides: no stick cell is left.
     #[error("gross sliding: {detail}")]
     GrossSliding {

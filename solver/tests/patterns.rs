@@ -216,3 +216,30 @@ fn flat_111_k_e_has_the_crystal_symmetry() {
         "30° and 90° are mirror images about 60°"
     );
 }
+
+#[test]
+fn an_unresolved_slip_zone_is_a_named_error_not_an_infinite_mu_a() {
+    // 32² cells of 200 µm: the few contact cells on the circle-A islands all
+    // stay below the friction bound at F = 0.3 μP, so a = c.
+    let mut spec = table_1c("Ni", "circle-A", 32, 200.0, 0.0);
+    spec.tangential_ratio = 0.3;
+    spec.coupling = false;
+    let err = solve_case(&spec, &mut KernelCache::new()).unwrap_err();
+    assert!(
+        matches!(err, solver::SolverError::SlipUnresolved { .. }),
+        "{err}"
+    );
+    let msg = err.to_string();
+    assert!(
+        msg.contains("contact cells stick") && msg.contains("grid.spacing_um"),
+        "{msg}"
+    );
+    // The same surface resolved finely enough slips at its outline.
+    let mut fine = table_1c("Ni", "circle-A", 128, 50.0, 0.0);
+    fine.tangential_ratio = 0.3;
+    fine.coupling = false;
+    let ok = solve_case(&fine, &mut KernelCache::new()).unwrap();
+    let s = &ok.scalars;
+    assert!(s.stick_radius_m < s.contact_radius_m);
+    assert!(s.mu_a.is_some_and(|m| m.is_finite() && m > 0.0));
+}
