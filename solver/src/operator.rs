@@ -405,6 +405,12 @@ impl Operator {
         self.apply(&[(Z, p)], &mut [(Z, uz)]);
     }
 
+    /// Adds the tangential displacements of a shear field to `(ux, uy)`
+    /// (accumulated in the inverse transforms, no extra pass).
+    pub fn tangential_add(&mut self, qx: &[f64], qy: &[f64], ux: &mut [f64], uy: &mut [f64]) {
+        self.round(&[(X, qx), (Y, qy)], &mut [(X, ux), (Y, uy)], true);
+    }
+
     /// Tangential displacements under shear only.
     pub fn tangential(&mut self, qx: &[f64], qy: &[f64], ux: &mut [f64], uy: &mut [f64]) {
         self.apply(&[(X, qx), (Y, qy)], &mut [(X, ux), (Y, uy)]);
@@ -615,6 +621,11 @@ mod tests {
         op.tangential(&t[0], &t[1], &mut ux, &mut uy);
         check(&ux, &want[0], "xy->x");
         check(&uy, &want[1], "xy->y");
+        // Accumulating variant: twice the field gives twice the displacement.
+        op.tangential_add(&t[0], &t[1], &mut ux, &mut uy);
+        let twice = |v: &[f64]| v.iter().map(|x| 2.0 * x).collect::<Vec<f64>>();
+        check(&ux, &twice(&want[0]), "xy->x added");
+        check(&uy, &twice(&want[1]), "xy->y added");
         op.apply(&[(X, &t[0]), (Y, &t[1])], &mut [(Z, &mut uz)]);
         check(&uz, &want[2], "xy->z");
         // The energy product by Parseval equals t · (K t) in real space.

@@ -595,12 +595,8 @@ fn cg_disc(
             dqx[i] = qx[i] - dqx[i];
             dqy[i] = qy[i] - dqy[i];
         }
-        op.tangential(&dqx, &dqy, zx, zy);
+        op.tangential_add(&dqx, &dqy, ux, uy);
         out.applications += 1;
-        for i in 0..len {
-            ux[i] += zx[i];
-            uy[i] += zy[i];
-        }
         fresh = false;
         age += 1;
     }
