@@ -500,12 +500,7 @@ mod tests {
     }
 
     fn cu111_cell(grid: Grid) -> impl Fn(f64, f64) -> Block {
-        let c = crate::presets::material("Cu(111)").unwrap().stiffness();
-        let kernel = crate::aniso::AngularKernel::new(&c);
-        move |x, y| {
-            let k = crate::aniso::cell_influence(&kernel, x, y, grid.dx, grid.dy);
-            std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)]))
-        }
+        crate::case::cell_influence(&crate::presets::material("Cu(111)").unwrap(), grid)
     }
 
     #[test]

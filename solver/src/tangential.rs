@@ -84,6 +84,22 @@ fn norm(x: f64, y: f64) -> f64 {
     (x * x + y * y).sqrt()
 }
 
+/// The slip field `s = C q + e` of tractions `q` (`e`: the coupling term, if any).
+fn slip_field(
+    op: &mut Operator,
+    extra: Option<(&[f64], &[f64])>,
+    (qx, qy): (&[f64], &[f64]),
+    (sx, sy): (&mut [f64], &mut [f64]),
+) {
+    op.tangential(qx, qy, sx, sy);
+    if let Some((ex, ey)) = extra {
+        for i in 0..sx.len() {
+            sx[i] += ex[i];
+            sy[i] += ey[i];
+        }
+    }
+}
+
 /// Exact projection of `z` onto { |q_i| ≤ b_i, Σ q_i = target }: q_i = Π_i(z_i + λ).
 /// Returns `None` if no λ satisfies the force (gross sliding).
 fn project(
@@ -237,16 +253,6 @@ pub fn solve_tangential(
     // Step 1/L, L the largest eigenvalue of the tangential block.
     let step = 1.0 / op.tangential_bound();
 
-    let slip_field = |op: &mut Operator, qx: &[f64], qy: &[f64], sx: &mut [f64], sy: &mut [f64]| {
-        op.tangential(qx, qy, sx, sy);
-        if let Some((ex, ey)) = prob.extra {
-            for i in 0..sx.len() {
-                sx[i] += ex[i];
-                sy[i] += ey[i];
-            }
-        }
-    };
-
     // Phase 1: projected conjugate gradient (below). Phase 2, only if phase 1
     // did not converge: FISTA from where it stopped.
     let cg = cg_disc(
@@ -290,7 +296,7 @@ pub fn solve_tangential(
     for it in 1..=fista_budget {
         report.iterations = cg.iterations + it;
         report.applications += 1;
-        slip_field(op, &yx, &yy, &mut sx, &mut sy);
+        slip_field(op, prob.extra, (&yx, &yy), (&mut sx, &mut sy));
         for &i in &cells {
             zx[i] = yx[i] - step * sx[i];
             zy[i] = yy[i] - step * sy[i];
@@ -345,7 +351,7 @@ pub fn solve_tangential(
     // Final slip, stick set, shift and KKT residuals of the returned tractions.
     // A converged CG phase left `s = C q + e` of these tractions in (sx, sy).
     if !(cg.converged && fista_budget == 0) {
-        slip_field(op, &qx, &qy, &mut sx, &mut sy);
+        slip_field(op, prob.extra, (&qx, &qy), (&mut sx, &mut sy));
     }
     let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
     for &i in &cells {
@@ -468,13 +474,7 @@ fn cg_disc(
         out.iterations = it;
         if age >= REFRESH {
             out.applications += 1;
-            op.tangential(qx, qy, ux, uy);
-            if let Some((ex, ey)) = prob.extra {
-                for i in 0..len {
-                    ux[i] += ex[i];
-                    uy[i] += ey[i];
-                }
-            }
+            slip_field(op, prob.extra, (qx, qy), (ux, uy));
             fresh = true;
             age = 0;
         }
