@@ -92,7 +92,50 @@ impl Fft2 {
         self.forward_rows(input, self.n, self.n, out);
     }
 
+    /// Row stage of [`Fft2::forward_padded`]: the row transforms of the `N`
+    /// non-zero rows, in place in the transposed spectrum. Entries `N..M` of
+    /// each column are left as they were; [`Fft2::forward_column`] zeroes and
+    /// transforms one column, so a caller can process a column while it is in
+    /// cache (the spectral products between the forward and inverse column
+    /// transforms, see `Operator::apply`).
+    pub fn forward_rows_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
+        self.row_stage(input, self.n, self.n, out);
+    }
+
+    /// Column `kx` (`M` values, `col`) of a spectrum after
+    /// [`Fft2::forward_rows_padded`]: zero padding, then the forward column transform.
+    pub fn forward_column(&mut self, col: &mut [Complex64]) {
+        debug_assert_eq!(col.len(), self.m);
+        col[self.n..].fill(Complex64::default());
+        self.col_fwd.process_with_scratch(col, &mut self.scratch);
+    }
+
+    /// Inverse column transform of column `col` (`M` values) of a spectrum;
+    /// [`Fft2::inverse_rows_cropped`] completes the inverse transform.
+    pub fn inverse_column(&mut self, col: &mut [Complex64]) {
+        debug_assert_eq!(col.len(), self.m);
+        self.col_inv.process_with_scratch(col, &mut self.scratch);
+    }
+
+    /// Row stage of [`Fft2::inverse_cropped`] (`add`: of
+    /// [`Fft2::inverse_cropped_add`]) on a spectrum whose columns have been
+    /// through [`Fft2::inverse_column`].
+    pub fn inverse_rows_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64], add: bool) {
+        self.inverse_row_stage(spec, self.n, self.n, out, add);
+    }
+
     fn forward_rows(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
+        let m = self.m;
+        let h = m / 2 + 1;
+        self.row_stage(input, nrows, ncols, out);
+        // Zero padding rows.
+        for kx in 0..h {
+            out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
+        }
+        self.col_fwd.process_with_scratch(out, &mut self.scratch);
+    }
+
+    fn row_stage(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
         let m = self.m;
         let h = m / 2 + 1;
         debug_assert_eq!(input.len(), nrows * ncols);
@@ -117,11 +160,6 @@ impl Fft2 {
                 }
             }
         }
-        // Zero padding rows.
-        for kx in 0..h {
-            out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
-        }
-        self.col_fwd.process_with_scratch(out, &mut self.scratch);
     }
 
     /// Row stage of a forward transform of a full `M x M` real array supplied
@@ -173,11 +211,22 @@ impl Fft2 {
         out: &mut [f64],
         add: bool,
     ) {
+        self.col_inv.process_with_scratch(spec, &mut self.scratch);
+        self.inverse_row_stage(spec, n, ncols, out, add);
+    }
+
+    fn inverse_row_stage(
+        &mut self,
+        spec: &mut [Complex64],
+        n: usize,
+        ncols: usize,
+        out: &mut [f64],
+        add: bool,
+    ) {
         let m = self.m;
         let h = m / 2 + 1;
         debug_assert_eq!(spec.len(), m * h);
         debug_assert_eq!(out.len(), n * ncols);
-        self.col_inv.process_with_scratch(spec, &mut self.scratch);
         let scale = 1.0 / (m as f64 * m as f64);
         // The first n rows, a tile at a time: gather from the transposed
         // spectrum, then inverse row transforms.

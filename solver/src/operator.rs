@@ -99,7 +99,24 @@ enum Kr<'a> {
     Cj(&'a [Complex64]),
 }
 
-impl Kr<'_> {
+impl<'a> Kr<'a> {
+    /// The values `r` of this spectrum (one column of the transposed layout).
+    fn part(self, r: std::ops::Range<usize>) -> Kr<'a> {
+        match self {
+            Kr::Re(v) => Kr::Re(&v[r]),
+            Kr::Cx(v) => Kr::Cx(&v[r]),
+            Kr::Cj(v) => Kr::Cj(&v[r]),
+        }
+    }
+
+    /// True for the placeholder of an unused slot.
+    fn is_empty(self) -> bool {
+        match self {
+            Kr::Re(v) => v.is_empty(),
+            Kr::Cx(v) | Kr::Cj(v) => v.is_empty(),
+        }
+    }
+
     #[inline(always)]
     fn at(self, f: usize) -> Complex64 {
         match self {
@@ -155,6 +172,29 @@ fn mix(k: &[[Kr; 2]; 2], ns: usize, nd: usize, w0: &mut [Complex64], w1: &mut [C
     }
 }
 
+/// `Σ_f conj(â, b̂) K̂ (â, b̂)ᵀ` over one column of the symmetric tangential
+/// block's spectra: `K_xx |â|² + K_yy |b̂|² + 2 Re(conj(â) K_xy b̂)`. Four
+/// partial sums, so the additions do not wait on each other.
+fn energy_column(a: &[Complex64], b: &[Complex64], d0: &[f64], d1: &[f64], c: &[Complex64]) -> f64 {
+    let term = |f: usize| {
+        let (a, b, c) = (a[f], b[f], c[f]);
+        let (sr, si) = (a.re * b.re + a.im * b.im, a.re * b.im - a.im * b.re);
+        d0[f] * (a.re * a.re + a.im * a.im)
+            + d1[f] * (b.re * b.re + b.im * b.im)
+            + 2.0 * (c.re * sr - c.im * si)
+    };
+    let len = a.len();
+    let mut acc = [0.0; 4];
+    let body = len / 4 * 4;
+    for f in (0..body).step_by(4) {
+        for (k, s) in acc.iter_mut().enumerate() {
+            *s += term(f + k);
+        }
+    }
+    let tail: f64 = (body..len).map(term).sum();
+    acc.iter().sum::<f64>() + tail
+}
+
 /// The `(i, j)` components stored, in the order of a build: diagonal, then
 /// `xy`, `xz`, `yz`.
 const STORED: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
@@ -172,6 +212,8 @@ pub struct Operator {
     coarse: Vec<CoarseLevel>,
     /// Fourier preconditioner of the normal iteration on this grid.
     precond: FourierPrecond,
+    /// The operator of the last contact window asked for (see [`Operator::window`]).
+    window: Option<Box<Operator>>,
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian
@@ -304,6 +346,89 @@ impl Operator {
             tangential_bound,
             coarse,
             precond: FourierPrecond::new(grid),
+            window: None,
+        }
+    }
+
+    /// The operator of an `nw x nw` window of this grid (same cells, `nw ≤ N`):
+    /// the same influence coefficients for offsets below `nw` cells, on the
+    /// smaller `2nw x 2nw` wrap-around grid. Fields that vanish outside a
+    /// window (tractions on the contact cells) are applied exactly by it, and
+    /// its transforms cost `(nw/N)²` of this grid's. The last window is kept;
+    /// one of a different size replaces it.
+    pub fn window(&mut self, nw: usize) -> &mut Operator {
+        assert!(
+            nw >= 1 && nw <= self.grid.n,
+            "window {nw} on a {} grid",
+            self.grid.n
+        );
+        if self.window.as_ref().map(|w| w.grid.n) != Some(nw) {
+            self.window = None;
+            self.window = Some(Box::new(self.build_window(nw)));
+        }
+        self.window.as_mut().expect("set above")
+    }
+
+    /// The side of the window operator kept, if any.
+    pub fn window_len(&self) -> Option<usize> {
+        self.window.as_ref().map(|w| w.grid.n)
+    }
+
+    fn build_window(&mut self, nw: usize) -> Operator {
+        let grid = Grid { n: nw, ..self.grid };
+        let m = self.fft.padded_len();
+        let mw = 2 * nw;
+        let mut fft = Fft2::new(nw);
+        // One component at a time: its real-space table on this grid (an
+        // inverse transform of the stored spectrum), the window's offsets
+        // (row and column `nw` zero, as in a build) into the window's spectrum.
+        let mut spec = vec![Complex64::default(); self.fft.spectrum_len()];
+        let mut table = vec![0.0; m * m];
+        let mut row = vec![0.0; mw];
+        let source = |i: usize| if i < nw { i } else { i + m - mw };
+        let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(STORED.len());
+        for &(i, j) in &STORED {
+            match self.spectra.component(i, j) {
+                Kr::Re(v) => spec
+                    .iter_mut()
+                    .zip(v)
+                    .for_each(|(z, &r)| *z = Complex64::new(r, 0.0)),
+                Kr::Cx(v) => spec.copy_from_slice(v),
+                Kr::Cj(_) => unreachable!("stored components are not conjugates"),
+            }
+            self.fft.inverse_full(&mut spec, &mut table);
+            let mut w = vec![Complex64::default(); fft.spectrum_len()];
+            for iy in 0..mw {
+                for (ix, r) in row.iter_mut().enumerate() {
+                    *r = if iy == nw || ix == nw {
+                        0.0
+                    } else {
+                        table[source(iy) * m + source(ix)]
+                    };
+                }
+                fft.forward_row_into(iy, &row, &mut w);
+            }
+            fft.forward_columns(&mut w);
+            out.push(w);
+        }
+        drop((spec, table));
+        let mut out = out.into_iter();
+        let mut next = || out.next().expect("six components");
+        let mut real = || next().iter().map(|z| z.re).collect::<Vec<f64>>();
+        let diag = [real(), real(), real()];
+        let off = [next(), next(), next()];
+        let spectra = Spectra { diag, off };
+        let slen = fft.spectrum_len();
+        Operator {
+            grid,
+            tangential_bound: tangential_symbol_max(&spectra),
+            fft,
+            spectra,
+            work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
+            // A window serves tangential solves: no coarse levels.
+            coarse: Vec::new(),
+            precond: FourierPrecond::new(grid),
+            window: None,
         }
     }
 
@@ -333,10 +458,15 @@ impl Operator {
     }
 
     /// `u_i (+)= Σ_j K_ij * t_j` for one or two sources and destinations.
+    ///
+    /// The row transforms run over whole fields; the column stage runs one
+    /// column (`M` values) at a time through forward transforms, spectral
+    /// products and inverse transforms while it is in cache, instead of three
+    /// passes over the work spectra.
     fn round(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])], add: bool) {
         let [w0, w1] = &mut self.work;
         for ((_, t), w) in src.iter().zip([&mut *w0, &mut *w1]) {
-            self.fft.forward_padded(t, w);
+            self.fft.forward_rows_padded(t, w);
         }
         let mut k = [[Kr::Re(&[]); 2]; 2];
         for (kd, (i, _)) in k.iter_mut().zip(dst.iter()) {
@@ -344,24 +474,43 @@ impl Operator {
                 *kds = self.spectra.component(*i, j);
             }
         }
-        mix(&k, src.len(), dst.len(), w0, w1);
-        for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
-            if add {
-                self.fft.inverse_cropped_add(w, u);
-            } else {
-                self.fft.inverse_cropped(w, u);
+        let m = self.fft.padded_len();
+        let (ns, nd) = (src.len(), dst.len());
+        for r in (0..m / 2 + 1).map(|kx| kx * m..(kx + 1) * m) {
+            let (c0, c1) = (&mut w0[r.clone()], &mut w1[r.clone()]);
+            self.fft.forward_column(c0);
+            if ns > 1 {
+                self.fft.forward_column(c1);
             }
+            let kc = k.map(|row| {
+                row.map(|kr| {
+                    if kr.is_empty() {
+                        kr
+                    } else {
+                        kr.part(r.clone())
+                    }
+                })
+            });
+            mix(&kc, ns, nd, c0, c1);
+            self.fft.inverse_column(c0);
+            if nd > 1 {
+                self.fft.inverse_column(c1);
+            }
+        }
+        for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
+            self.fft.inverse_rows_cropped(w, u, add);
         }
     }
 
     /// The elastic energy product `⟨t, K t⟩ = Σ_cells t · (K t)` of a shear
     /// field `t = (tx, ty)`, from its spectra by Parseval: two forward
     /// transforms and no inverse (`t` is zero outside the grid, so the sum
-    /// over the padded grid is the sum over the cells).
+    /// over the padded grid is the sum over the cells). Each column's products
+    /// are summed as soon as its transforms are done.
     pub fn tangential_energy(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
         let [w0, w1] = &mut self.work;
-        self.fft.forward_padded(tx, w0);
-        self.fft.forward_padded(ty, w1);
+        self.fft.forward_rows_padded(tx, w0);
+        self.fft.forward_rows_padded(ty, w1);
         let m = self.fft.padded_len();
         let (kxx, kyy, kxy) = (
             &self.spectra.diag[X],
@@ -370,16 +519,12 @@ impl Operator {
         );
         let mut sum = 0.0;
         for (kx, col) in (0..m / 2 + 1).map(|kx| (kx, kx * m..(kx + 1) * m)) {
+            let (c0, c1) = (&mut w0[col.clone()], &mut w1[col.clone()]);
+            self.fft.forward_column(c0);
+            self.fft.forward_column(c1);
             // A half spectrum: columns 0 < kx < M/2 stand for their mirror too.
             let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
-            let mut part = 0.0;
-            for f in col {
-                let (a, b) = (w0[f], w1[f]);
-                part += kxx[f] * a.norm_sqr()
-                    + kyy[f] * b.norm_sqr()
-                    + 2.0 * (a.conj() * kxy[f] * b).re;
-            }
-            sum += weight * part;
+            sum += weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col]);
         }
         sum / (m as f64 * m as f64)
     }
