@@ -281,6 +281,13 @@ impl KernelCache {
             took = start.elapsed().as_secs_f64();
             self.ops.insert(key.clone(), op);
         }
+        // Only the operator in use keeps a contact-window operator: the
+        // others' are rebuilt from their spectra (tens of ms) when needed.
+        for (k, op) in self.ops.iter_mut() {
+            if *k != key {
+                op.drop_window();
+            }
+        }
         Ok((self.ops.get_mut(&key).expect("inserted above"), took))
     }
 }

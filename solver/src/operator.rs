@@ -369,6 +369,11 @@ impl Operator {
         self.window.as_mut().expect("set above")
     }
 
+    /// Frees the window operator kept, if any.
+    pub fn drop_window(&mut self) {
+        self.window = None;
+    }
+
     /// The side of the window operator kept, if any.
     pub fn window_len(&self) -> Option<usize> {
         self.window.as_ref().map(|w| w.grid.n)

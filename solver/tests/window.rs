@@ -3,6 +3,9 @@
 //! the whole grid (the tractions vanish outside the contact, so the two are the
 //! same equations).
 
+mod common;
+
+use solver::case::{solve_case, KernelCache};
 use solver::operator::{Grid, Operator, X, Y, Z};
 use solver::tangential::{
     contact_window, solve_tangential, solve_tangential_on_grid, TangentialProblem,
@@ -175,4 +178,20 @@ fn windowed_and_whole_grid_tangential_solves_agree_for_a_111_crystal() {
     let fx: f64 = win.qx.iter().sum::<f64>() * da;
     let fy: f64 = win.qy.iter().sum::<f64>() * da;
     assert!((fx - force[0]).hypot(fy - force[1]) < 1e-9 * f);
+}
+
+#[test]
+fn only_the_operator_in_use_keeps_its_window() {
+    // Table 1a on 64 cells of 5 µm: contact about 42 cells across, window 48.
+    let a = common::table_1a_fe(64, 5.0, false, 0.6);
+    let mut b = a.clone();
+    b.material = solver::material::Material::isotropic("Fe-soft", 150.0e9, 0.3).unwrap();
+    let mut cache = KernelCache::new();
+    let out = solve_case(&a, &mut cache).unwrap();
+    assert!(out.scalars.converged);
+    assert_eq!(cache.operator(&a).unwrap().0.window_len(), Some(48));
+    let out = solve_case(&b, &mut cache).unwrap();
+    assert!(out.scalars.converged);
+    assert!(cache.operator(&b).unwrap().0.window_len().is_some());
+    assert_eq!(cache.operator(&a).unwrap().0.window_len(), None);
 }
