@@ -189,30 +189,26 @@ impl Fft2 {
     /// Inverse transform of a spectrum (consumed as scratch) into the first
     /// `N x N` block of the real result, scaled by `1/M²`.
     pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
-        self.inverse_rows(spec, self.n, self.n, out, false);
+        self.inverse_columns(spec);
+        self.inverse_row_stage(spec, self.n, self.n, out, false);
     }
 
     /// [`Fft2::inverse_cropped`] added to `out` instead of overwriting it.
     pub fn inverse_cropped_add(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
-        self.inverse_rows(spec, self.n, self.n, out, true);
+        self.inverse_columns(spec);
+        self.inverse_row_stage(spec, self.n, self.n, out, true);
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the full
     /// `M x M` real array, scaled by `1/M²`.
     pub fn inverse_full(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
-        self.inverse_rows(spec, self.m, self.m, out, false);
+        self.inverse_columns(spec);
+        self.inverse_row_stage(spec, self.m, self.m, out, false);
     }
 
-    fn inverse_rows(
-        &mut self,
-        spec: &mut [Complex64],
-        n: usize,
-        ncols: usize,
-        out: &mut [f64],
-        add: bool,
-    ) {
+    /// Inverse column transforms of a whole spectrum.
+    fn inverse_columns(&mut self, spec: &mut [Complex64]) {
         self.col_inv.process_with_scratch(spec, &mut self.scratch);
-        self.inverse_row_stage(spec, n, ncols, out, add);
     }
 
     fn inverse_row_stage(
