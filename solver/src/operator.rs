@@ -77,6 +77,17 @@ impl Spectra {
             + self.off.iter().map(|o| o.len() * 16).sum::<usize>()
     }
 
+    /// The spectra of the six stored components, complex and in the order
+    /// of `STORED`; the diagonal ones are kept as their real parts.
+    fn from_stored(six: Vec<Vec<Complex64>>) -> Spectra {
+        let mut six = six.into_iter();
+        let mut next = || six.next().expect("six components");
+        let mut real = || next().iter().map(|z| z.re).collect::<Vec<f64>>();
+        let diag = [real(), real(), real()];
+        let off = [next(), next(), next()];
+        Spectra { diag, off }
+    }
+
     fn component(&self, i: usize, j: usize) -> Kr<'_> {
         match (i, j) {
             _ if i == j => Kr::Re(&self.diag[i]),
@@ -269,16 +280,10 @@ impl Operator {
                 fft.forward_row_into(iy, &row, out);
             }
         }
-        let mut full = full.into_iter();
-        let mut next = || {
-            let mut s = full.next().expect("six components");
-            fft.forward_columns(&mut s);
-            s
-        };
-        let mut real = || next().iter().map(|z| z.re).collect::<Vec<f64>>();
-        let diag = [real(), real(), real()];
-        let off = [next(), next(), next()];
-        Self::with_fft(grid, fft, Spectra { diag, off })
+        for s in full.iter_mut() {
+            fft.forward_columns(s);
+        }
+        Self::with_fft(grid, fft, Spectra::from_stored(full))
     }
 
     /// The nine real-space kernels on the `2N x 2N` wrap-around grid
@@ -304,15 +309,15 @@ impl Operator {
     pub fn from_tables(grid: Grid, real: &[Vec<f64>]) -> Self {
         let mut fft = Fft2::new(grid.n);
         let slen = fft.spectrum_len();
-        let mut spectrum = |i: usize, j: usize| {
-            let mut s = vec![Complex64::default(); slen];
-            fft.forward_full(&real[3 * i + j], &mut s);
-            s
-        };
-        let mut real_part = |i: usize| spectrum(i, i).iter().map(|z| z.re).collect();
-        let diag = [real_part(X), real_part(Y), real_part(Z)];
-        let off = [spectrum(X, Y), spectrum(X, Z), spectrum(Y, Z)];
-        Self::with_fft(grid, fft, Spectra { diag, off })
+        let six = STORED
+            .iter()
+            .map(|&(i, j)| {
+                let mut s = vec![Complex64::default(); slen];
+                fft.forward_full(&real[3 * i + j], &mut s);
+                s
+            })
+            .collect();
+        Self::with_fft(grid, fft, Spectra::from_stored(six))
     }
 
     /// An operator holding `spectra` (e.g. loaded from a store); `None` when
@@ -417,12 +422,7 @@ impl Operator {
             out.push(w);
         }
         drop((spec, table));
-        let mut out = out.into_iter();
-        let mut next = || out.next().expect("six components");
-        let mut real = || next().iter().map(|z| z.re).collect::<Vec<f64>>();
-        let diag = [real(), real(), real()];
-        let off = [next(), next(), next()];
-        let spectra = Spectra { diag, off };
+        let spectra = Spectra::from_stored(out);
         let slen = fft.spectrum_len();
         Operator {
             grid,
