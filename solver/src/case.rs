@@ -316,12 +316,6 @@ pub fn build_operator(material: &Material, grid: Grid) -> Operator {
     Operator::build(grid, cell_influence(material, grid))
 }
 
-/// The nine real-space kernel tables of a material on a grid (see
-/// [`Operator::tables`]); for tests and inspection, not needed to solve.
-pub fn kernel_tables(material: &Material, grid: Grid) -> Vec<Vec<f64>> {
-    Operator::tables(grid, cell_influence(material, grid))
-}
-
 /// The scalars of one solved case.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CaseScalars {

@@ -111,20 +111,32 @@ enum Kr<'a> {
 }
 
 impl<'a> Kr<'a> {
-    /// The values `r` of this spectrum (one column of the transposed layout).
+    /// The values `r` of this spectrum (one column of the transposed layout);
+    /// the empty placeholder of an unused slot stays empty.
     fn part(self, r: std::ops::Range<usize>) -> Kr<'a> {
+        fn cut<T>(v: &[T], r: std::ops::Range<usize>) -> &[T] {
+            if v.is_empty() {
+                v
+            } else {
+                &v[r]
+            }
+        }
         match self {
-            Kr::Re(v) => Kr::Re(&v[r]),
-            Kr::Cx(v) => Kr::Cx(&v[r]),
-            Kr::Cj(v) => Kr::Cj(&v[r]),
+            Kr::Re(v) => Kr::Re(cut(v, r)),
+            Kr::Cx(v) => Kr::Cx(cut(v, r)),
+            Kr::Cj(v) => Kr::Cj(cut(v, r)),
         }
     }
 
-    /// True for the placeholder of an unused slot.
-    fn is_empty(self) -> bool {
+    /// The whole spectrum as complex values, into `out`.
+    fn write_complex(self, out: &mut [Complex64]) {
         match self {
-            Kr::Re(v) => v.is_empty(),
-            Kr::Cx(v) | Kr::Cj(v) => v.is_empty(),
+            Kr::Re(v) => out
+                .iter_mut()
+                .zip(v)
+                .for_each(|(z, &r)| *z = Complex64::new(r, 0.0)),
+            Kr::Cx(v) => out.copy_from_slice(v),
+            Kr::Cj(v) => out.iter_mut().zip(v).for_each(|(z, c)| *z = c.conj()),
         }
     }
 
@@ -221,8 +233,9 @@ pub struct Operator {
     tangential_bound: f64,
     /// Coarse `K_zz` levels for nested initial guesses (finest first).
     coarse: Vec<CoarseLevel>,
-    /// Fourier preconditioner of the normal iteration on this grid.
-    precond: FourierPrecond,
+    /// Fourier preconditioner of the normal iteration on this grid, made on
+    /// first use (a window operator, which serves tangential solves, never needs it).
+    precond: Option<FourierPrecond>,
     /// The operator of the last contact window asked for (see [`Operator::window`]).
     window: Option<Box<Operator>>,
 }
@@ -333,10 +346,8 @@ impl Operator {
         let slen = fft.spectrum_len();
         let tangential_bound = tangential_symbol_max(&spectra);
         // The real K_zz table, transiently, for the Galerkin coarse levels.
-        let mut zz: Vec<Complex64> = spectra.diag[Z]
-            .iter()
-            .map(|&v| Complex64::new(v, 0.0))
-            .collect();
+        let mut zz = vec![Complex64::default(); slen];
+        spectra.component(Z, Z).write_complex(&mut zz);
         let m = fft.padded_len();
         let mut table = vec![0.0; m * m];
         fft.inverse_full(&mut zz, &mut table);
@@ -350,7 +361,7 @@ impl Operator {
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
             tangential_bound,
             coarse,
-            precond: FourierPrecond::new(grid),
+            precond: None,
             window: None,
         }
     }
@@ -398,14 +409,7 @@ impl Operator {
         let source = |i: usize| if i < nw { i } else { i + m - mw };
         let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(STORED.len());
         for &(i, j) in &STORED {
-            match self.spectra.component(i, j) {
-                Kr::Re(v) => spec
-                    .iter_mut()
-                    .zip(v)
-                    .for_each(|(z, &r)| *z = Complex64::new(r, 0.0)),
-                Kr::Cx(v) => spec.copy_from_slice(v),
-                Kr::Cj(_) => unreachable!("stored components are not conjugates"),
-            }
+            self.spectra.component(i, j).write_complex(&mut spec);
             self.fft.inverse_full(&mut spec, &mut table);
             let mut w = vec![Complex64::default(); fft.spectrum_len()];
             for iy in 0..mw {
@@ -432,7 +436,7 @@ impl Operator {
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
             // A window serves tangential solves: no coarse levels.
             coarse: Vec::new(),
-            precond: FourierPrecond::new(grid),
+            precond: None,
             window: None,
         }
     }
@@ -487,15 +491,7 @@ impl Operator {
             if ns > 1 {
                 self.fft.forward_column(c1);
             }
-            let kc = k.map(|row| {
-                row.map(|kr| {
-                    if kr.is_empty() {
-                        kr
-                    } else {
-                        kr.part(r.clone())
-                    }
-                })
-            });
+            let kc = k.map(|row| row.map(|kr| kr.part(r.clone())));
             mix(&kc, ns, nd, c0, c1);
             self.fft.inverse_column(c0);
             if nd > 1 {
@@ -536,7 +532,9 @@ impl Operator {
 
     /// The Fourier preconditioner of the normal iteration.
     pub fn precond_mut(&mut self) -> &mut FourierPrecond {
-        &mut self.precond
+        let grid = self.grid;
+        self.precond
+            .get_or_insert_with(|| FourierPrecond::new(grid))
     }
 
     /// The coarse `K_zz` levels below this grid (finest first).
@@ -586,11 +584,7 @@ mod tests {
 
     #[test]
     fn dcfft_equals_direct_summation_on_16x16_to_1e12() {
-        let grid = Grid {
-            n: 16,
-            dx: 1.0e-6,
-            dy: 1.3e-6,
-        };
+        let grid = grid(16, 1.0e-6, 1.3e-6);
         let (g, nu) = (80.0e9, 0.27);
         let cell = |x: f64, y: f64| isotropic_cell(g, nu, x, y, grid.dx, grid.dy);
         let mut op = Operator::build(grid, cell);
@@ -645,6 +639,10 @@ mod tests {
         u
     }
 
+    fn grid(n: usize, dx: f64, dy: f64) -> Grid {
+        Grid { n, dx, dy }
+    }
+
     fn max_abs(v: &[f64]) -> f64 {
         v.iter().fold(0.0, |m, x| m.max(x.abs()))
     }
@@ -656,11 +654,7 @@ mod tests {
     #[test]
     fn influence_tables_are_reciprocal_for_isotropic_and_111_crystals() {
         // Betti: K_ji(r) = K_ij(−r); on the wrap-around grid −r is index m − i.
-        let grid = Grid {
-            n: 12,
-            dx: 20e-6,
-            dy: 20e-6,
-        };
+        let grid = grid(12, 20e-6, 20e-6);
         let iso = |x: f64, y: f64| isotropic_cell(48.0e9, 0.34, x, y, grid.dx, grid.dy);
         for tables in [
             Operator::tables(grid, iso),
@@ -692,11 +686,7 @@ mod tests {
 
     #[test]
     fn row_by_row_build_equals_the_table_build() {
-        let grid = Grid {
-            n: 10,
-            dx: 20e-6,
-            dy: 20e-6,
-        };
+        let grid = grid(10, 20e-6, 20e-6);
         let cell = cu111_cell(grid);
         let a = Operator::build(grid, &cell);
         let b = Operator::from_tables(grid, &Operator::tables(grid, &cell));
@@ -720,11 +710,7 @@ mod tests {
     fn anisotropic_apply_equals_direct_summation_on_every_path() {
         // The reciprocal storage (K_yx from K_xy etc.) and each apply path
         // (1, 2 or 3 sources; 1, 2 or 3 destinations) against direct sums.
-        let grid = Grid {
-            n: 12,
-            dx: 20e-6,
-            dy: 25e-6,
-        };
+        let grid = grid(12, 20e-6, 25e-6);
         let cell = cu111_cell(grid);
         let mut op = Operator::build(grid, &cell);
         let n = grid.n;
