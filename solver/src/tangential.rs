@@ -106,11 +106,11 @@ fn project(
     (zx, zy): (&[f64], &[f64]),
     bound: &[f64],
     cells: &[usize],
+    cap: f64,
     target: [f64; 2],
     lambda: &mut [f64; 2],
     (qx, qy): (&mut [f64], &mut [f64]),
 ) -> Option<()> {
-    let cap: f64 = cells.iter().map(|&i| bound[i]).sum();
     let tnorm = target[0].hypot(target[1]);
     if tnorm >= cap {
         return None;
@@ -323,6 +323,8 @@ pub fn solve_tangential_on_grid(
     let mu = prob.friction;
     let cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
     let bound: Vec<f64> = p.iter().map(|&v| mu * v.max(0.0)).collect();
+    // Σ b_i over the contact cells: the largest force the discs can carry.
+    let cap: f64 = cells.iter().map(|&i| bound[i]).sum();
     let normal: f64 = p.iter().sum::<f64>() * da;
     let fnorm = prob.force[0].hypot(prob.force[1]);
     if fnorm >= mu * normal {
@@ -362,6 +364,7 @@ pub fn solve_tangential_on_grid(
         (&zx, &zy),
         &bound,
         &cells,
+        cap,
         target,
         &mut lambda,
         (&mut qx, &mut qy),
@@ -382,6 +385,7 @@ pub fn solve_tangential_on_grid(
         prob,
         &cells,
         &bound,
+        cap,
         target,
         (&mut qx, &mut qy),
         (&mut sx, &mut sy),
@@ -427,6 +431,7 @@ pub fn solve_tangential_on_grid(
             (&zx, &zy),
             &bound,
             &cells,
+            cap,
             target,
             &mut lambda,
             (&mut px, &mut py),
@@ -565,6 +570,7 @@ fn cg_disc(
     prob: &TangentialProblem,
     cells: &[usize],
     bound: &[f64],
+    cap: f64,
     target: [f64; 2],
     (qx, qy): (&mut [f64], &mut [f64]),
     (ux, uy): (&mut [f64], &mut [f64]),
@@ -575,7 +581,11 @@ fn cg_disc(
     let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
     let (mut tx, mut ty) = (vec![0.0; len], vec![0.0; len]);
     let (mut dqx, mut dqy) = (vec![0.0; len], vec![0.0; len]);
+    // Stick set of the current tractions: here, then after each projection.
     let mut stick = vec![false; len];
+    for &i in cells {
+        stick[i] = !on_bound(qx[i], qy[i], bound[i]);
+    }
     let mut g_old = 1.0;
     let mut conj = false;
     // The slip field in (ux, uy) is exact (`fresh`) or updated since `age` moves.
@@ -600,10 +610,9 @@ fn cg_disc(
             fresh = true;
             age = 0;
         }
-        // Stick set and the mean slip over it (the rigid shift δt).
+        // The mean slip over the stick set (the rigid shift δt).
         let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
         for &i in cells {
-            stick[i] = !on_bound(qx[i], qy[i], bound[i]);
             if stick[i] {
                 mx += ux[i];
                 my += uy[i];
@@ -657,10 +666,13 @@ fn cg_disc(
         let beta = if conj { gg / g_old } else { 0.0 };
         g_old = gg;
         // Outside the contact cells t (like Δq below) stays zero.
+        let mut num = 0.0;
         for &i in cells {
             if stick[i] {
-                tx[i] = ux[i] - d[0] + beta * tx[i];
-                ty[i] = uy[i] - d[1] + beta * ty[i];
+                let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
+                tx[i] = wx + beta * tx[i];
+                ty[i] = wy + beta * ty[i];
+                num += wx * tx[i] + wy * ty[i];
             } else {
                 tx[i] = 0.0;
                 ty[i] = 0.0;
@@ -668,18 +680,15 @@ fn cg_disc(
         }
         let den = op.tangential_energy(&tx, &ty);
         out.energy_products += 1;
-        let mut num = 0.0;
-        for &i in cells {
-            if stick[i] {
-                num += (ux[i] - d[0]) * tx[i] + (uy[i] - d[1]) * ty[i];
-            }
-        }
         if den <= 0.0 || !den.is_finite() {
             return Ok(out);
         }
         let tau = num / den;
-        // Trial point: CG step on stick cells, projected-gradient step on slip cells.
+        // Trial point: CG step on stick cells, projected-gradient step on slip
+        // cells; Δq holds the current tractions until the projection.
         for &i in cells {
+            dqx[i] = qx[i];
+            dqy[i] = qy[i];
             if stick[i] {
                 zx[i] = qx[i] - tau * tx[i];
                 zy[i] = qy[i] - tau * ty[i];
@@ -691,16 +700,13 @@ fn cg_disc(
                 zy[i] = qy[i] - tau * (uy[i] - d[1]);
             }
         }
-        for &i in cells {
-            dqx[i] = qx[i];
-            dqy[i] = qy[i];
-        }
         // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
         let mut l = [0.0; 2];
         project(
             (&*zx, &*zy),
             bound,
             cells,
+            cap,
             target,
             &mut l,
             (&mut *qx, &mut *qy),
@@ -708,18 +714,17 @@ fn cg_disc(
         .ok_or_else(|| SolverError::GrossSliding {
             detail: "no traction field satisfies both the friction discs and the force".into(),
         })?;
+        // The new stick set, whether it changed, and Δq of the move.
         let mut changed = false;
         for &i in cells {
-            if on_bound(qx[i], qy[i], bound[i]) == stick[i] {
-                changed = true;
-            }
-        }
-        conj = !changed;
-        // Slip field of the new tractions: u += C Δq.
-        for &i in cells {
+            let sticks = !on_bound(qx[i], qy[i], bound[i]);
+            changed |= sticks != stick[i];
+            stick[i] = sticks;
             dqx[i] = qx[i] - dqx[i];
             dqy[i] = qy[i] - dqy[i];
         }
+        conj = !changed;
+        // Slip field of the new tractions: u += C Δq.
         op.tangential_add(&dqx, &dqy, ux, uy);
         out.applications += 1;
         fresh = false;
