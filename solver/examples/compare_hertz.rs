@@ -8,7 +8,7 @@
 //! `cargo run --release -p mpcontact-solver --example compare_hertz -- --sizes 256,512 --reps 3`
 
 use solver::case::{build_operator, solve_case, CaseSpec, KernelCache};
-use solver::fft2::Fft2;
+use solver::fft2::{timing, Fft2};
 use solver::material::Material;
 use solver::normal::{solve_normal_with, NormalOptions};
 use solver::operator::{Grid, Operator};
@@ -122,6 +122,9 @@ fn hertz(n: usize, args: &Args, op: &mut Operator, options: NormalOptions) {
         sol.report.converged,
     );
     if !options.nested {
+        let in_situ = in_situ_ratio(|| {
+            solve_normal_with(op, &h, None, P, TOL, 10_000, None, options).expect("Hertz solve");
+        });
         // FFT floor of one fine iteration: the padded transforms of its operator
         // applications, plus (preconditioned) one unpadded periodic pair.
         let pair = fft_pair_seconds(Fft2::new(n), &sol.p, args.reps);
@@ -132,12 +135,35 @@ fn hertz(n: usize, args: &Args, op: &mut Operator, options: NormalOptions) {
         let pc = if options.precondition { periodic } else { 0.0 };
         let fft_s = (pair * apps + pc * its) / its;
         println!(
-            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"normal iteration, {mode}\", \"n\": {n}, \"threads\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"ok\": true}}",
+            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"normal iteration, {mode}\", \"n\": {n}, \"threads\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {in_situ:.3}, \"ok\": true}}",
             args.threads,
             apps / its,
             iter_s / fft_s
         );
     }
+}
+
+/// A solve's time divided by the time spent in its own transforms, timed in
+/// place (`fft2::timing`), so the transforms run with the iteration's cache
+/// state rather than hot in a loop of their own. The clock reads of the timed
+/// spans are calibrated with empty spans and taken out of both times.
+fn in_situ_ratio(mut solve: impl FnMut()) -> f64 {
+    const EMPTY: u64 = 200_000;
+    timing::start();
+    let t0 = Instant::now();
+    for _ in 0..EMPTY {
+        drop(std::hint::black_box(timing::Span::new()));
+    }
+    let outer = t0.elapsed().as_secs_f64() / EMPTY as f64;
+    let (inner, _) = timing::stop();
+    let inner = inner / EMPTY as f64;
+    timing::start();
+    let t0 = Instant::now();
+    solve();
+    let total = t0.elapsed().as_secs_f64();
+    let (fft, spans) = timing::stop();
+    let spans = spans as f64;
+    (total - spans * outer) / (fft - spans * inner)
 }
 
 /// Best time of one forward + inverse transform pair (our `Fft2`, with its
@@ -209,6 +235,9 @@ fn slip(n: usize, args: &Args, coupling: bool) {
             max_iterations: 20_000,
             q_init: None,
         };
+        let in_situ = in_situ_ratio(|| {
+            solve_tangential(op, &prob).expect("tangential solve");
+        });
         let mut ts = Vec::new();
         let mut rep = None;
         for _ in 0..args.reps {
@@ -232,7 +261,7 @@ fn slip(n: usize, args: &Args, coupling: bool) {
         let iter_s = median(ts) / its;
         let fft_s = (2.0 * pair * apps + 2.0 * fwd * rep.energy_products as f64) / its;
         println!(
-            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"tangential CG iteration (Cattaneo-Mindlin)\", \"n\": {n}, \"window\": {nw}, \"threads\": {}, \"iterations\": {}, \"cg_iterations\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"energy_products_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"ok\": true}}",
+            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"tangential CG iteration (Cattaneo-Mindlin)\", \"n\": {n}, \"window\": {nw}, \"threads\": {}, \"iterations\": {}, \"cg_iterations\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"energy_products_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {in_situ:.3}, \"ok\": true}}",
             args.threads,
             rep.iterations,
             rep.cg_iterations,

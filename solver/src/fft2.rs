@@ -12,6 +12,58 @@ use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
+/// Time spent in the transforms of this thread, for benchmarks that divide an
+/// iteration's time by the time of the transforms it ran (the "FFT floor" in
+/// place). Off unless [`timing::start`] was called: each public transform
+/// method of [`Fft2`] is then one timed span.
+pub mod timing {
+    use std::cell::Cell;
+    use std::time::Instant;
+
+    thread_local! {
+        static ON: Cell<bool> = const { Cell::new(false) };
+        static SECONDS: Cell<f64> = const { Cell::new(0.0) };
+        static SPANS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    /// Starts timing this thread's transforms from zero.
+    pub fn start() {
+        ON.set(true);
+        SECONDS.set(0.0);
+        SPANS.set(0);
+    }
+
+    /// Stops timing; returns the seconds spent in transforms and the number
+    /// of timed spans (each includes about one clock read of overhead, which
+    /// the caller can calibrate with empty spans).
+    pub fn stop() -> (f64, u64) {
+        ON.set(false);
+        (SECONDS.get(), SPANS.get())
+    }
+
+    /// One timed span: from its creation to its drop, when timing is on.
+    pub struct Span(Option<Instant>);
+
+    impl Span {
+        /// Starts a span (a no-op unless timing is on).
+        #[inline]
+        #[allow(clippy::new_without_default)]
+        pub fn new() -> Self {
+            Span(ON.get().then(Instant::now))
+        }
+    }
+
+    impl Drop for Span {
+        #[inline]
+        fn drop(&mut self) {
+            if let Some(t) = self.0 {
+                SECONDS.set(SECONDS.get() + t.elapsed().as_secs_f64());
+                SPANS.set(SPANS.get() + 1);
+            }
+        }
+    }
+}
+
 /// Rows transformed together and moved to (from) the transposed spectrum as
 /// one tile: the tile (`TILE x (M/2 + 1)` complex values) stays in cache.
 const TILE: usize = 16;
@@ -84,11 +136,13 @@ impl Fft2 {
 
     /// Forward transform of a full `M x M` real array (used for kernels).
     pub fn forward_full(&mut self, input: &[f64], out: &mut [Complex64]) {
+        let _span = timing::Span::new();
         self.forward_rows(input, self.m, self.m, out);
     }
 
     /// Forward transform of an `N x N` field (row-major, `N` columns) zero-padded to `M x M`.
     pub fn forward_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
+        let _span = timing::Span::new();
         self.forward_rows(input, self.n, self.n, out);
     }
 
@@ -99,12 +153,14 @@ impl Fft2 {
     /// cache (the spectral products between the forward and inverse column
     /// transforms, see `Operator::apply`).
     pub fn forward_rows_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
+        let _span = timing::Span::new();
         self.row_stage(input, self.n, self.n, out);
     }
 
     /// Column `kx` (`M` values, `col`) of a spectrum after
     /// [`Fft2::forward_rows_padded`]: zero padding, then the forward column transform.
     pub fn forward_column(&mut self, col: &mut [Complex64]) {
+        let _span = timing::Span::new();
         debug_assert_eq!(col.len(), self.m);
         col[self.n..].fill(Complex64::default());
         self.col_fwd.process_with_scratch(col, &mut self.scratch);
@@ -113,6 +169,7 @@ impl Fft2 {
     /// Inverse column transform of column `col` (`M` values) of a spectrum;
     /// [`Fft2::inverse_rows_cropped`] completes the inverse transform.
     pub fn inverse_column(&mut self, col: &mut [Complex64]) {
+        let _span = timing::Span::new();
         debug_assert_eq!(col.len(), self.m);
         self.col_inv.process_with_scratch(col, &mut self.scratch);
     }
@@ -121,6 +178,7 @@ impl Fft2 {
     /// [`Fft2::inverse_cropped_add`]) on a spectrum whose columns have been
     /// through [`Fft2::inverse_column`].
     pub fn inverse_rows_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64], add: bool) {
+        let _span = timing::Span::new();
         self.inverse_row_stage(spec, self.n, self.n, out, add);
     }
 
@@ -166,6 +224,7 @@ impl Fft2 {
     /// one row at a time: transforms row `iy` (`M` values) into its place in
     /// `out`. After all rows, [`Fft2::forward_columns`] completes the transform.
     pub fn forward_row_into(&mut self, iy: usize, row: &[f64], out: &mut [Complex64]) {
+        let _span = timing::Span::new();
         let m = self.m;
         let h = m / 2 + 1;
         debug_assert_eq!(row.len(), m);
@@ -183,18 +242,21 @@ impl Fft2 {
 
     /// Column stage completing the rows given to [`Fft2::forward_row_into`].
     pub fn forward_columns(&mut self, out: &mut [Complex64]) {
+        let _span = timing::Span::new();
         self.col_fwd.process_with_scratch(out, &mut self.scratch);
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the first
     /// `N x N` block of the real result, scaled by `1/M²`.
     pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        let _span = timing::Span::new();
         self.inverse_columns(spec);
         self.inverse_row_stage(spec, self.n, self.n, out, false);
     }
 
     /// [`Fft2::inverse_cropped`] added to `out` instead of overwriting it.
     pub fn inverse_cropped_add(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        let _span = timing::Span::new();
         self.inverse_columns(spec);
         self.inverse_row_stage(spec, self.n, self.n, out, true);
     }
@@ -202,6 +264,7 @@ impl Fft2 {
     /// Inverse transform of a spectrum (consumed as scratch) into the full
     /// `M x M` real array, scaled by `1/M²`.
     pub fn inverse_full(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
+        let _span = timing::Span::new();
         self.inverse_columns(spec);
         self.inverse_row_stage(spec, self.m, self.m, out, false);
     }
@@ -253,5 +316,35 @@ impl Fft2 {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timing_counts_transforms_only_while_on() {
+        let n = 8;
+        let mut fft = Fft2::new(n);
+        let field: Vec<f64> = (0..n * n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+        let mut out = vec![0.0; n * n];
+        // Off by default (each test runs on its own thread).
+        fft.forward_padded(&field, &mut spec);
+        assert_eq!(timing::stop(), (0.0, 0));
+        timing::start();
+        fft.forward_padded(&field, &mut spec);
+        fft.inverse_cropped(&mut spec, &mut out);
+        let (seconds, spans) = timing::stop();
+        assert_eq!(spans, 2);
+        assert!(seconds > 0.0);
+        // Timing does not touch the numbers: the round trip is exact.
+        for (a, b) in field.iter().zip(&out) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        // Off again after stop.
+        fft.forward_padded(&field, &mut spec);
+        assert_eq!(timing::stop().1, 2);
     }
 }
