@@ -162,14 +162,12 @@ fn polonsky_keer(
             break;
         }
         let gbar = sum_g / nc as f64;
-        for gi in g.iter_mut() {
-            *gi -= gbar;
-        }
         // Search direction: the (preconditioned) residual on the contact cells,
         // conjugated with the previous direction unless the set changed.
         let gg = if precondition {
-            for (a, &pi) in active.iter_mut().zip(p.iter()) {
-                *a = pi > 0.0;
+            for i in 0..len {
+                g[i] -= gbar;
+                active[i] = p[i] > 0.0;
             }
             op.precondition(&g, &active, &mut z);
             let mut gz = 0.0;
@@ -182,6 +180,7 @@ fn polonsky_keer(
         } else {
             let mut gg = 0.0;
             for i in 0..len {
+                g[i] -= gbar;
                 if p[i] > 0.0 {
                     gg += g[i] * g[i];
                 }
@@ -202,17 +201,17 @@ fn polonsky_keer(
         g_old = gg;
         op.apply_zz(&t, &mut r);
         report.applications += 1;
-        let mut sr = 0.0;
+        let (mut sr, mut num) = (0.0, 0.0);
         for i in 0..len {
             if p[i] > 0.0 {
                 sr += r[i];
+                num += g[i] * t[i];
             }
         }
         let rbar = sr / nc as f64;
-        let (mut num, mut den) = (0.0, 0.0);
+        let mut den = 0.0;
         for i in 0..len {
             if p[i] > 0.0 {
-                num += g[i] * t[i];
                 den += (r[i] - rbar) * t[i];
             }
         }
@@ -223,9 +222,10 @@ fn polonsky_keer(
         // Step, clip, and re-admit cells that interpenetrate (overlap set).
         let mut overlap = false;
         let mut clipped = false;
-        p_old.copy_from_slice(p);
+        let mut total = 0.0;
         for i in 0..len {
             let old = p[i];
+            p_old[i] = old;
             let mut new = if old > 0.0 {
                 let v = old - tau * t[i];
                 if v < 0.0 {
@@ -242,9 +242,10 @@ fn polonsky_keer(
                 overlap = true;
             }
             p[i] = new;
+            total += new;
         }
         delta = if overlap { 0.0 } else { 1.0 };
-        let total: f64 = p.iter().sum::<f64>() * da;
+        let total = total * da;
         if total <= 0.0 || !total.is_finite() {
             return Err(SolverError::invalid(
                 "solver",
@@ -253,13 +254,12 @@ fn polonsky_keer(
         }
         let scale = load_n / total;
         let mut change = 0.0;
+        // u = K p follows the step unless the set changed by clipping or overlap.
+        u_valid = !(clipped || overlap);
         for i in 0..len {
             p[i] *= scale;
             change += (p[i] - p_old[i]).abs();
-        }
-        u_valid = !(clipped || overlap);
-        if u_valid {
-            for i in 0..len {
+            if u_valid {
                 u[i] = scale * (u[i] - tau * r[i]);
             }
         }
