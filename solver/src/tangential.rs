@@ -101,6 +101,7 @@ fn slip_field(
 }
 
 /// Exact projection of `z` onto { |q_i| ≤ b_i, Σ q_i = target }: q_i = Π_i(z_i + λ).
+/// `cap` is Σ b_i over `cells` (fixed for a solve, so the caller sums it once).
 /// Returns `None` if no λ satisfies the force (gross sliding).
 fn project(
     (zx, zy): (&[f64], &[f64]),
