@@ -344,7 +344,6 @@ impl Operator {
 
     fn with_fft(grid: Grid, mut fft: Fft2, spectra: Spectra) -> Self {
         let slen = fft.spectrum_len();
-        let tangential_bound = tangential_symbol_max(&spectra);
         // The real K_zz table, transiently, for the Galerkin coarse levels.
         let mut zz = vec![Complex64::default(); slen];
         spectra.component(Z, Z).write_complex(&mut zz);
@@ -354,12 +353,19 @@ impl Operator {
         drop(zz);
         let coarse = coarse_levels(grid, &table);
         drop(table);
+        Self::assemble(grid, fft, spectra, coarse)
+    }
+
+    /// An operator from its parts; work spectra and the tangential bound
+    /// follow from them, the preconditioner and a window come on first use.
+    fn assemble(grid: Grid, fft: Fft2, spectra: Spectra, coarse: Vec<CoarseLevel>) -> Self {
+        let slen = fft.spectrum_len();
         Operator {
             grid,
+            tangential_bound: tangential_symbol_max(&spectra),
             fft,
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
-            tangential_bound,
             coarse,
             precond: None,
             window: None,
@@ -379,6 +385,7 @@ impl Operator {
             self.grid.n
         );
         if self.window.as_ref().map(|w| w.grid.n) != Some(nw) {
+            // Free the old window before building the new one (lower peak).
             self.window = None;
             self.window = Some(Box::new(self.build_window(nw)));
         }
@@ -426,19 +433,8 @@ impl Operator {
             out.push(w);
         }
         drop((spec, table));
-        let spectra = Spectra::from_stored(out);
-        let slen = fft.spectrum_len();
-        Operator {
-            grid,
-            tangential_bound: tangential_symbol_max(&spectra),
-            fft,
-            spectra,
-            work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
-            // A window serves tangential solves: no coarse levels.
-            coarse: Vec::new(),
-            precond: None,
-            window: None,
-        }
+        // A window serves tangential solves: no coarse levels.
+        Self::assemble(grid, fft, Spectra::from_stored(out), Vec::new())
     }
 
     /// The kernel spectra held (what a kernel store persists).
