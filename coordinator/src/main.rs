@@ -109,11 +109,10 @@ fn kernel_json(material: &str, angles: &[f64]) -> Result<String> {
     let m = solver::presets::material(material).ok_or_else(|| {
         anyhow!("--material {material}: unknown preset (see `mpcontact materials`)")
     })?;
-    let c = m.stiffness();
     let rows: Vec<serde_json::Value> = angles
         .iter()
         .map(|&deg| {
-            let h = solver::aniso::stroh::surface_compliance(&c, deg.to_radians());
+            let h = m.surface_compliance(deg.to_radians());
             let part = |f: fn(&num_complex::Complex64) -> f64| -> Vec<Vec<f64>> {
                 (0..3)
                     .map(|i| (0..3).map(|j| f(&h[(i, j)])).collect())
@@ -133,23 +132,8 @@ fn kernel_json(material: &str, angles: &[f64]) -> Result<String> {
 fn materials_table() -> String {
     let mut s = String::from("name       kind         E_eq_GPa  nu_eq   constants (GPa)\n");
     for m in solver::presets::materials() {
-        let (kind, consts) = match &m.elasticity {
-            solver::material::Elasticity::Isotropic(i) => (
-                "isotropic",
-                format!("E = {:.2}, nu = {}", i.youngs / 1e9, i.poisson),
-            ),
-            solver::material::Elasticity::Anisotropic(c) => {
-                let mut parts = Vec::new();
-                for i in 0..6 {
-                    for j in i..6 {
-                        if c[(i, j)] != 0.0 {
-                            parts.push(format!("C{}{} = {}", i + 1, j + 1, c[(i, j)] / 1e9));
-                        }
-                    }
-                }
-                ("anisotropic", parts.join(", "))
-            }
-        };
+        let model = m.model();
+        let (kind, consts) = (model.kind(), model.describe());
         s.push_str(&format!(
             "{:<10} {:<12} {:>8.2}  {:<6}  {}\n",
             m.name,

@@ -1,11 +1,11 @@
 //! PNG contour maps of one case's surface fields, in the paper's style
 //! (Figs. 4, 5, 7, 8): p/p_H, qx/p_H, qy/p_H, slip magnitude and the
 //! stick/slip map, axes in units of the contact radius, with a colour bar.
-//! Drawing only; the fields come from `solver::case::Fields`.
+//! Drawing only; the fields come from `solver::Fields`.
 
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
-use solver::case::{CaseScalars, Fields};
+use solver::{CaseScalars, Fields};
 use std::path::Path;
 
 /// Colour of `t ∈ [0, 1]` on a perceptually ordered ramp (dark blue → yellow).

@@ -5,9 +5,7 @@ use crate::config::Config;
 use anyhow::{anyhow, Context, Result};
 use npyz::WriterBuilder;
 use serde::Serialize;
-use solver::case::{calibrate_k_e, mu_apparent, solve_case, CaseScalars, CaseSpec, Fields};
-use solver::material::Elasticity;
-use solver::surface::Surface;
+use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Fields};
 use std::io::BufWriter;
 use std::path::Path;
 
@@ -70,24 +68,22 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         None => config.sweep.angles_deg.values()?[0],
     };
     let spec = config.spec(material, surface, angle)?;
-    spec.validate().map_err(|e| anyhow!("{e}"))?;
+    spec.validate()
+        .map_err(|e| config.explain(e, material, surface))?;
     let mut cache = worker::kernel_store::FileStore::cache();
     let out =
         solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
     let mut scalars = out.scalars;
-    // Anisotropic material on a patterned surface: K_E from the flat twin (PHYSICS.md §7).
-    if matches!(spec.material.elasticity, Elasticity::Anisotropic(_)) && scalars.mu_a.is_some() {
-        let k_e = if spec.surface == Surface::Flat {
-            calibrate_k_e(&scalars, spec.friction, spec.normal_force_n)
+    // Anisotropic material: K_E from the flat twin (docs/physics-choices.md).
+    if spec.needs_flat_calibration() && scalars.mu_a.is_some() {
+        let flat = if spec.surface == spec.flat_twin().surface {
+            scalars.clone()
         } else {
-            let mut flat = spec.clone();
-            flat.surface = Surface::Flat;
-            let f = solve_case(&flat, &mut cache).map_err(|e| anyhow!("flat twin for K_E: {e}"))?;
-            calibrate_k_e(&f.scalars, spec.friction, spec.normal_force_n)
+            solve_case(&spec.flat_twin(), &mut cache)
+                .map_err(|e| anyhow!("flat twin for K_E: {e}"))?
+                .scalars
         };
-        scalars.k_e = k_e;
-        scalars.k_e_source = "flat-calibrated".into();
-        scalars.mu_a = Some(mu_apparent(&scalars, spec.normal_force_n, k_e));
+        calibrate_on_flat(&mut scalars, &flat, &spec.load);
     }
     std::fs::create_dir_all(args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
@@ -101,10 +97,9 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
             "not-converged"
         },
         scalars: &scalars,
-        apparent_radius_definition:
-            "radius of the circle with the area of the convex hull of the contact (stick) cells",
-        grid_points: spec.grid_points,
-        spacing_m: spec.spacing_m,
+        apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
+        grid_points: spec.grid.n,
+        spacing_m: spec.grid.dx,
         spec: &spec,
     };
     let path = args.out.join("case.json");
@@ -114,8 +109,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     // The numbers are written first; a picture that cannot be drawn (e.g. no
     // system font) is a warning, not a lost result.
     let title = format!("{material}, {surface}, ψ = {angle}°");
-    if let Err(e) = crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.spacing_m)
-    {
+    if let Err(e) = crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.grid.dx) {
         eprintln!("warning: maps not written: {e:#}");
     }
     Ok(scalars)

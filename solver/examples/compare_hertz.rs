@@ -7,13 +7,12 @@
 //!
 //! `cargo run --release -p mpcontact-solver --example compare_hertz -- --sizes 256,512 --reps 3`
 
-use solver::case::{build_operator, solve_case, CaseSpec, KernelCache};
 use solver::fft2::{timing, Fft2};
-use solver::material::Material;
-use solver::normal::{solve_normal_with, NormalOptions};
-use solver::operator::{Grid, Operator};
-use solver::surface::Surface;
-use solver::tangential::{contact_window, solve_tangential, TangentialProblem};
+use solver::normal::{NormalOptions, NormalProblem};
+use solver::tangential::{TangentialProblem, TangentialStart};
+use solver::window::contact_window;
+use solver::{build_operator, solve_case, CaseSpec, Grid, KernelCache, Load, Material, Numerics};
+use solver::{Resident, Surface};
 use std::time::Instant;
 
 const E: f64 = 210.0e9;
@@ -86,17 +85,22 @@ fn gap(g: Grid) -> Vec<f64> {
         .collect()
 }
 
-fn hertz(n: usize, args: &Args, op: &mut Operator, options: NormalOptions) {
+fn hertz(n: usize, args: &Args, res: &mut Resident, options: NormalOptions) {
     let g = grid(n);
     let h = gap(g);
     let a = hertz_radius();
     let pmax = 3.0 * P / (2.0 * std::f64::consts::PI * a * a);
+    let prob = NormalProblem {
+        tolerance: TOL,
+        max_iterations: 10_000,
+        options,
+        ..NormalProblem::new(&h, P)
+    };
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..args.reps {
         let t0 = Instant::now();
-        let sol =
-            solve_normal_with(op, &h, None, P, TOL, 10_000, None, options).expect("Hertz solve");
+        let sol = res.solve_normal(&prob).expect("Hertz solve");
         times.push(t0.elapsed().as_secs_f64());
         last = Some(sol);
     }
@@ -123,7 +127,7 @@ fn hertz(n: usize, args: &Args, op: &mut Operator, options: NormalOptions) {
     );
     if !options.nested {
         let in_situ = in_situ_ratio(|| {
-            solve_normal_with(op, &h, None, P, TOL, 10_000, None, options).expect("Hertz solve");
+            res.solve_normal(&prob).expect("Hertz solve");
         });
         // FFT floor of one fine iteration: the padded transforms of its operator
         // applications, plus (preconditioned) one unpadded periodic pair.
@@ -196,22 +200,25 @@ fn slip(n: usize, args: &Args, coupling: bool) {
     let spec = CaseSpec {
         material: Material::isotropic("Fe", E, NU).expect("valid"),
         surface: Surface::Flat,
-        grid_points: n,
-        spacing_m: 4.5 * a / n as f64,
-        indenter_radius_m: R,
-        normal_force_n: P,
-        friction: MU,
-        tangential_ratio: 0.6,
-        angle_deg: 0.0,
-        coupling,
-        tolerance: TOL,
-        tangential_tolerance: 1e-6,
-        max_iterations: 20_000,
-        coupling_tolerance: 1e-8,
-        max_coupling_iterations: 50,
+        grid: Grid::square(n, 4.5 * a / n as f64),
+        load: Load {
+            indenter_radius_m: R,
+            normal_force_n: P,
+            friction: MU,
+            tangential_ratio: 0.6,
+            angle_deg: 0.0,
+        },
+        numerics: Numerics {
+            coupling,
+            tolerance: TOL,
+            tangential_tolerance: 1e-6,
+            max_iterations: 20_000,
+            coupling_tolerance: 1e-8,
+            max_coupling_iterations: 50,
+        },
     };
     let mut cache = KernelCache::new();
-    let _ = cache.operator(&spec).expect("kernel");
+    let _ = cache.resident(&spec).expect("kernel");
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..args.reps {
@@ -224,7 +231,7 @@ fn slip(n: usize, args: &Args, coupling: bool) {
         // FFT floor of one tangential CG iteration: a cold tangential solve at
         // the final pressure; each application is two padded pairs, each
         // energy product two padded forward transforms.
-        let (op, _) = cache.operator(&spec).expect("kernel");
+        let (res, _) = cache.resident(&spec).expect("kernel");
         let force = spec.tangential_force();
         let prob = TangentialProblem {
             p: &out.fields.p,
@@ -233,22 +240,22 @@ fn slip(n: usize, args: &Args, coupling: bool) {
             extra: None,
             tolerance: 1e-6,
             max_iterations: 20_000,
-            q_init: None,
+            start: TangentialStart::Proportional,
         };
         let in_situ = in_situ_ratio(|| {
-            solve_tangential(op, &prob).expect("tangential solve");
+            res.solve_tangential(&prob).expect("tangential solve");
         });
         let mut ts = Vec::new();
         let mut rep = None;
         for _ in 0..args.reps {
             let t0 = Instant::now();
-            let sol = solve_tangential(op, &prob).expect("tangential solve");
+            let sol = res.solve_tangential(&prob).expect("tangential solve");
             ts.push(t0.elapsed().as_secs_f64());
             rep = Some(sol.report);
         }
         let rep = rep.expect("at least one rep");
         // The iteration runs on the contact window's grid, when there is one.
-        let nw = op.window_len().unwrap_or(n);
+        let nw = res.windows.side().unwrap_or(n);
         let pw = match contact_window(n, &out.fields.p) {
             Some(w) if w.n == nw => w.gather(&out.fields.p),
             _ => out.fields.p.clone(),
@@ -271,7 +278,7 @@ fn slip(n: usize, args: &Args, coupling: bool) {
         );
     }
     let s = &out.scalars;
-    let da = spec.spacing_m * spec.spacing_m;
+    let da = spec.grid.cell_area();
     let contact = out.fields.p.iter().filter(|&&v| v > 0.0).count() as f64 * da;
     let stick = out.fields.stick.iter().filter(|&&v| v > 0.5).count() as f64 * da;
     let ca = (stick / contact).sqrt();
@@ -300,13 +307,13 @@ fn main() {
     let material = Material::isotropic("Fe", E, NU).expect("valid material");
     for &n in &args.sizes {
         let g = grid(n);
-        let mut op = build_operator(&material, g);
+        let mut res = Resident::new(build_operator(&material, g));
         for (nested, precondition) in [(true, true), (false, true), (false, false)] {
             let options = NormalOptions {
                 nested,
                 precondition,
             };
-            hertz(n, &args, &mut op, options);
+            hertz(n, &args, &mut res, options);
         }
     }
     for &n in &args.slip_sizes {

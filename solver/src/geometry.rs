@@ -1,7 +1,7 @@
 //! Planar geometry of cell sets: convex-hull area of a set of grid cells
 //! (used for the apparent contact and stick radii). No physics.
 
-use crate::operator::Grid;
+use crate::grid::Grid;
 
 /// Area (m²) of the convex hull of the union of the cell squares in `mask`
 /// (row-major `[iy][ix]`). Zero for an empty mask.

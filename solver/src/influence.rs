@@ -3,7 +3,7 @@
 //! (Love for normal–normal, integrated Cerruti/Boussinesq for the rest).
 //! No FFTs here; `operator` turns these into kernel spectra.
 //!
-//! Convention (PHYSICS.md): z points into the body, traction `t = (qx, qy, p)`,
+//! Convention (docs/physics-choices.md, Geometry): z points into the body, traction `t = (qx, qy, p)`,
 //! result `k[i][j]` = displacement component i per unit traction component j (m/Pa).
 
 use std::f64::consts::PI;

@@ -1,23 +1,72 @@
 //! # mpcontact solver
 //!
-//! Frictional contact of a rigid sphere on an elastic half-space: materials,
-//! influence coefficients, the DC-FFT operator, normal (Polonsky–Keer) and
-//! partial-slip tangential solvers with normal–tangential coupling, and the
-//! per-case scalars (contact/stick radii, shifts, apparent friction μa).
+//! Frictional contact of a rigid sphere on an elastic — isotropic or
+//! anisotropic, flat or micropatterned — half-space: materials, influence
+//! coefficients, the DC-FFT operator, normal (Polonsky–Keer) and partial-slip
+//! tangential solvers with normal–tangential coupling, and the per-case
+//! scalars (contact/stick radii, shifts, apparent friction μa).
 //! No IPC, no files, no CLI.
+//!
+//! The curated API is re-exported at the crate root:
+//!
+//! ```no_run
+//! use solver::{presets, solve_case, CaseSpec, Grid, KernelCache, Load, Numerics};
+//! let spec = CaseSpec {
+//!     material: presets::material("Cu(111)").unwrap(),
+//!     surface: presets::surface("circle-A").unwrap(),
+//!     grid: Grid::square(256, 30e-6),
+//!     load: Load {
+//!         indenter_radius_m: 0.2,
+//!         normal_force_n: 6000.0,
+//!         friction: 0.3,
+//!         tangential_ratio: 0.6,
+//!         angle_deg: 30.0,
+//!     },
+//!     numerics: Numerics::default(),
+//! };
+//! let mut cache = KernelCache::new(); // keeps the kernel for the next case
+//! let out = solve_case(&spec, &mut cache).unwrap();
+//! println!("μa = {:?}", out.scalars.mu_a);
+//! ```
+//!
+//! The operator and the two solvers are public too (modules `operator`,
+//! `normal`, `tangential`, `window`), for problems other than a case: the
+//! model / operator / solver split of Tamaas. Modules marked hidden are
+//! public only for this crate's own tests, benches and examples.
 
 pub mod aniso;
-pub mod case;
-pub mod error;
+mod case;
+mod coupling;
+mod error;
+#[doc(hidden)]
 pub mod fft2;
+#[doc(hidden)]
 pub mod geometry;
+mod grid;
+#[doc(hidden)]
 pub mod influence;
-pub mod material;
+mod kernels;
+mod material;
+#[doc(hidden)]
 pub mod multilevel;
 pub mod normal;
 pub mod operator;
 pub mod presets;
-pub mod surface;
+mod results;
+mod spec;
+mod surface;
 pub mod tangential;
+pub mod window;
 
+pub use case::solve_case;
 pub use error::SolverError;
+pub use grid::Grid;
+pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
+pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
+pub use operator::{Operator, Spectra};
+pub use results::{
+    calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
+    APPARENT_RADIUS_DEFINITION, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+};
+pub use spec::{CaseSpec, Load, Numerics, MAX_GRID_POINTS};
+pub use surface::{Island, LatticeKind, Surface};

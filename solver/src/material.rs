@@ -1,10 +1,39 @@
 //! Elastic materials of the substrate: a general 6x6 stiffness in the surface
 //! frame (SI, Voigt xx, yy, zz, yz, xz, xy; z into the body), plus the
 //! isotropic-equivalent (E, ν) used to normalise results and in Mindlin's K_E.
+//! Each kind of elasticity is an [`ElasticModel`]: what the operator build,
+//! the kernel store and the listings need of it. The one place that checks
+//! constants (positive definite stiffness, E and ν ranges).
 
 use crate::error::SolverError;
-use nalgebra::Matrix6;
+use crate::grid::Grid;
+use crate::influence::{isotropic_cell, Block};
+use nalgebra::{Matrix3, Matrix6};
+use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
+
+/// The cell-influence function `K(x, y)` of a material on a grid: the
+/// displacement at offset `(x, y)` from a uniformly loaded cell, per unit traction.
+pub type CellInfluence = Box<dyn Fn(f64, f64) -> Block>;
+
+/// A model of the elastic half-space: yields the cell influence
+/// coefficients the DC-FFT operator is built from, and says what a caller
+/// needs to know about them.
+pub trait ElasticModel {
+    /// The cell-influence function on `grid`.
+    fn cell_influence(&self, grid: Grid) -> CellInfluence;
+    /// True when building its tables is expensive enough to persist them
+    /// (numerical Green's functions), false for closed forms.
+    fn persist_tables(&self) -> bool;
+    /// Stiffness in the surface frame (Pa, Voigt).
+    fn stiffness(&self) -> Matrix6<f64>;
+    /// Checks the constants; errors name the parameter (`youngs`, `poisson`, `stiffness`).
+    fn validate(&self) -> Result<(), SolverError>;
+    /// `isotropic` or `anisotropic`, for listings.
+    fn kind(&self) -> &'static str;
+    /// The constants in GPa, for listings.
+    fn describe(&self) -> String;
+}
 
 /// Isotropic constants (SI).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -54,6 +83,68 @@ impl Isotropic {
     }
 }
 
+impl ElasticModel for Isotropic {
+    fn cell_influence(&self, grid: Grid) -> CellInfluence {
+        let (g, nu, dx, dy) = (self.shear(), self.poisson, grid.dx, grid.dy);
+        Box::new(move |x, y| isotropic_cell(g, nu, x, y, dx, dy))
+    }
+    fn persist_tables(&self) -> bool {
+        false
+    }
+    fn stiffness(&self) -> Matrix6<f64> {
+        Isotropic::stiffness(self)
+    }
+    fn validate(&self) -> Result<(), SolverError> {
+        Isotropic::new(self.youngs, self.poisson).map(|_| ())
+    }
+    fn kind(&self) -> &'static str {
+        "isotropic"
+    }
+    fn describe(&self) -> String {
+        format!("E = {:.2}, nu = {}", self.youngs / 1e9, self.poisson)
+    }
+}
+
+/// A general anisotropic stiffness in the surface frame (Pa, Voigt): kernels
+/// from the Stroh / Barnett–Lothe Green's function by ray integration.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Anisotropic(#[serde(with = "matrix6_serde")] pub Matrix6<f64>);
+
+impl ElasticModel for Anisotropic {
+    fn cell_influence(&self, grid: Grid) -> CellInfluence {
+        let (dx, dy) = (grid.dx, grid.dy);
+        let kernel = crate::aniso::AngularKernel::new(&self.0);
+        Box::new(move |x, y| {
+            let k = crate::aniso::cell_influence(&kernel, x, y, dx, dy);
+            std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)]))
+        })
+    }
+    fn persist_tables(&self) -> bool {
+        true
+    }
+    fn stiffness(&self) -> Matrix6<f64> {
+        self.0
+    }
+    fn validate(&self) -> Result<(), SolverError> {
+        check_stiffness(&self.0).map_err(|r| SolverError::invalid("stiffness", r))
+    }
+    fn kind(&self) -> &'static str {
+        "anisotropic"
+    }
+    fn describe(&self) -> String {
+        let mut parts = Vec::new();
+        for i in 0..6 {
+            for j in i..6 {
+                if self.0[(i, j)] != 0.0 {
+                    parts.push(format!("C{}{} = {}", i + 1, j + 1, self.0[(i, j)] / 1e9));
+                }
+            }
+        }
+        parts.join(", ")
+    }
+}
+
 /// How the half-space responds: closed forms exist only for the isotropic case.
 // A material is built once per case; the size difference of the variants is irrelevant.
 #[allow(clippy::large_enum_variant)]
@@ -62,7 +153,17 @@ pub enum Elasticity {
     /// Isotropic: closed-form influence coefficients.
     Isotropic(Isotropic),
     /// General anisotropic stiffness in the surface frame (Pa, Voigt).
-    Anisotropic(#[serde(with = "matrix6_serde")] Matrix6<f64>),
+    Anisotropic(Anisotropic),
+}
+
+impl Elasticity {
+    /// The model behind this elastic law.
+    pub fn model(&self) -> &dyn ElasticModel {
+        match self {
+            Elasticity::Isotropic(iso) => iso,
+            Elasticity::Anisotropic(c) => c,
+        }
+    }
 }
 
 /// A substrate material.
@@ -95,21 +196,84 @@ impl Material {
         stiffness: Matrix6<f64>,
         equivalent: Isotropic,
     ) -> Result<Self, SolverError> {
-        check_stiffness(&stiffness)
-            .map_err(|r| SolverError::invalid(&format!("materials.{name}.stiffness"), r))?;
-        Ok(Material {
+        let m = Material {
             name: name.to_string(),
-            elasticity: Elasticity::Anisotropic(stiffness),
+            elasticity: Elasticity::Anisotropic(Anisotropic(stiffness)),
             equivalent,
-        })
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// A cubic crystal (constants in Pa) whose surface normal `normal` and
+    /// in-plane x direction `x_dir` are given in crystal axes; the
+    /// isotropic-equivalent constants are `equivalent` or, without them, the
+    /// Hill average of the stiffness.
+    pub fn cubic(
+        name: &str,
+        [c11, c12, c44]: [f64; 3],
+        normal: [f64; 3],
+        x_dir: [f64; 3],
+        equivalent: Option<Isotropic>,
+    ) -> Result<Self, SolverError> {
+        let c = crate::aniso::crystal::cubic_stiffness_rotated(c11, c12, c44, normal, x_dir)
+            .map_err(|r| SolverError::invalid("orientation", r))?;
+        Self::with_stiffness(name, c, equivalent)
+    }
+
+    /// An anisotropic material from its stiffness (Pa, Voigt, surface frame);
+    /// the isotropic-equivalent constants are `equivalent` or, without them,
+    /// the Hill average.
+    pub fn with_stiffness(
+        name: &str,
+        stiffness: Matrix6<f64>,
+        equivalent: Option<Isotropic>,
+    ) -> Result<Self, SolverError> {
+        Anisotropic(stiffness).validate()?;
+        let equivalent = match equivalent {
+            Some(e) => e,
+            None => hill_average(&stiffness)
+                .ok_or_else(|| SolverError::invalid("stiffness", "singular stiffness"))?,
+        };
+        Self::anisotropic(name, stiffness, equivalent)
+    }
+
+    /// The elastic model of this material.
+    pub fn model(&self) -> &dyn ElasticModel {
+        self.elasticity.model()
     }
 
     /// Stiffness in the surface frame (Pa, Voigt).
     pub fn stiffness(&self) -> Matrix6<f64> {
-        match &self.elasticity {
-            Elasticity::Isotropic(iso) => iso.stiffness(),
-            Elasticity::Anisotropic(c) => *c,
+        self.model().stiffness()
+    }
+
+    /// Surface compliance `H(θ)` (1/Pa) of the Fourier-domain surface Green's
+    /// function along in-plane direction `theta` (rad), Stroh / Barnett–Lothe.
+    pub fn surface_compliance(&self, theta: f64) -> Matrix3<Complex64> {
+        crate::aniso::stroh::surface_compliance(&self.stiffness(), theta)
+    }
+
+    /// Checks the constants: the model's, and for an anisotropic material
+    /// the isotropic-equivalent ones (E > 0, |ν| < 1). Errors name the
+    /// parameter (`youngs`, `poisson`, `stiffness`, `equivalent`).
+    pub fn validate(&self) -> Result<(), SolverError> {
+        self.model().validate()?;
+        if !self.is_isotropic() {
+            // The isotropic-equivalent constants only normalise; the paper's
+            // Cu(111) has ν = 0.503, so only E > 0 and |ν| < 1 are required.
+            let e = &self.equivalent;
+            if !(e.youngs.is_finite() && e.youngs > 0.0 && e.poisson.abs() < 1.0) {
+                return Err(SolverError::invalid(
+                    "equivalent",
+                    format!(
+                        "needs E > 0 and -1 < ν < 1, got E = {} Pa, ν = {}",
+                        e.youngs, e.poisson
+                    ),
+                ));
+            }
         }
+        Ok(())
     }
 
     /// True when the closed-form isotropic kernels apply.
@@ -119,8 +283,28 @@ impl Material {
 }
 
 /// Checks that a stiffness is finite, symmetric and positive definite; the message says what fails.
-pub fn check_stiffness(c: &Matrix6<f64>) -> Result<(), String> {
+fn check_stiffness(c: &Matrix6<f64>) -> Result<(), String> {
     crate::aniso::crystal::check_positive_definite(c)
+}
+
+/// Hill average of a stiffness (mean of the Voigt and Reuss bounds of the
+/// bulk and shear moduli): isotropic constants for normalisation. `None`
+/// for a singular stiffness.
+pub fn hill_average(c: &Matrix6<f64>) -> Option<Isotropic> {
+    let s = c.try_inverse()?;
+    let kv = (c[(0, 0)] + c[(1, 1)] + c[(2, 2)] + 2.0 * (c[(0, 1)] + c[(0, 2)] + c[(1, 2)])) / 9.0;
+    let gv = (c[(0, 0)] + c[(1, 1)] + c[(2, 2)] - (c[(0, 1)] + c[(0, 2)] + c[(1, 2)])
+        + 3.0 * (c[(3, 3)] + c[(4, 4)] + c[(5, 5)]))
+        / 15.0;
+    let kr = 1.0 / (s[(0, 0)] + s[(1, 1)] + s[(2, 2)] + 2.0 * (s[(0, 1)] + s[(0, 2)] + s[(1, 2)]));
+    let gr = 15.0
+        / (4.0 * (s[(0, 0)] + s[(1, 1)] + s[(2, 2)]) - 4.0 * (s[(0, 1)] + s[(0, 2)] + s[(1, 2)])
+            + 3.0 * (s[(3, 3)] + s[(4, 4)] + s[(5, 5)]));
+    let (k, g) = (0.5 * (kv + kr), 0.5 * (gv + gr));
+    Some(Isotropic {
+        youngs: 9.0 * k * g / (3.0 * k + g),
+        poisson: (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)),
+    })
 }
 
 mod matrix6_serde {

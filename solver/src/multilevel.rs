@@ -1,4 +1,5 @@
-//! Coarse grids for nested (coarse-to-fine) initial guesses.
+//! The normal solver's aids: coarse grids for nested (coarse-to-fine) initial
+//! guesses, and the Fourier preconditioner. Used only by `normal`.
 //!
 //! A coarse cell is the union of a 2x2 block of fine cells. Its normal
 //! influence coefficients are the Galerkin projection of the fine ones: the
@@ -11,7 +12,7 @@
 //! the fine grid.
 
 use crate::fft2::Fft2;
-use crate::operator::Grid;
+use crate::grid::Grid;
 use num_complex::Complex64;
 
 /// Fourier preconditioner of the normal iteration: `z = Π W Π g` with `W` the
@@ -261,57 +262,5 @@ mod tests {
                 assert!((f[fy * n + fx] - (2.0 * x - 3.0 * y)).abs() < 1e-12);
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod solve_tests {
-    use crate::influence::isotropic_cell;
-    use crate::normal::{solve_normal_with, NormalOptions};
-    use crate::operator::{Grid, Operator};
-
-    /// Nesting and preconditioning change the path, not the answer: all four
-    /// combinations reach the same discrete Hertz pressure, and the
-    /// preconditioned iteration needs far fewer fine iterations.
-    #[test]
-    fn nested_and_preconditioned_solves_reach_the_plain_solution() {
-        let n = 128;
-        let (e, nu, r, load) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64, 20.0_f64);
-        let a = (3.0 * load * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
-        let d = 4.5 * a / n as f64;
-        let grid = Grid { n, dx: d, dy: d };
-        let g = e / (2.0 * (1.0 + nu));
-        let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
-        let h: Vec<f64> = (0..grid.len())
-            .map(|i| {
-                let (x, y) = (grid.x(i % n), grid.y(i / n));
-                (x * x + y * y) / (2.0 * r)
-            })
-            .collect();
-        let mut runs = Vec::new();
-        for (nested, precondition) in [(false, false), (true, false), (false, true), (true, true)] {
-            let options = NormalOptions {
-                nested,
-                precondition,
-            };
-            let s = solve_normal_with(&mut op, &h, None, load, 1e-12, 5000, None, options).unwrap();
-            assert!(s.report.converged, "{options:?}");
-            runs.push(s);
-        }
-        let pmax = runs[0].p.iter().cloned().fold(0.0, f64::max);
-        for s in &runs[1..] {
-            let err =
-                s.p.iter()
-                    .zip(&runs[0].p)
-                    .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-            assert!(err < 1e-8 * pmax, "max |Δp| = {:e} of p_max", err / pmax);
-            assert!((s.approach / runs[0].approach - 1.0).abs() < 1e-10);
-        }
-        let plain = runs[0].report.iterations;
-        let pc = runs[2].report.iterations;
-        assert!(
-            2 * pc < plain,
-            "preconditioned {pc} vs plain {plain} iterations"
-        );
     }
 }

@@ -6,8 +6,8 @@
 //! many times; `apply` allocates nothing.
 
 use crate::fft2::Fft2;
+pub use crate::grid::Grid;
 use crate::influence::Block;
-use crate::multilevel::{coarse_levels, CoarseLevel, FourierPrecond};
 use num_complex::Complex64;
 
 /// Displacement / traction component index: x, y (tangential) and z (normal).
@@ -16,40 +16,6 @@ pub const X: usize = 0;
 pub const Y: usize = 1;
 /// z component (normal; pressure for tractions).
 pub const Z: usize = 2;
-
-/// Square computational grid: `n x n` cells of `dx x dy`, centred on the origin.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Grid {
-    /// Cells per side.
-    pub n: usize,
-    /// Cell size along x, m.
-    pub dx: f64,
-    /// Cell size along y, m.
-    pub dy: f64,
-}
-
-impl Grid {
-    /// Cell area, m².
-    pub fn cell_area(&self) -> f64 {
-        self.dx * self.dy
-    }
-    /// x coordinate of the centre of column `ix` (origin at the grid centre).
-    pub fn x(&self, ix: usize) -> f64 {
-        (ix as f64 - 0.5 * (self.n as f64 - 1.0)) * self.dx
-    }
-    /// y coordinate of the centre of row `iy`.
-    pub fn y(&self, iy: usize) -> f64 {
-        (iy as f64 - 0.5 * (self.n as f64 - 1.0)) * self.dy
-    }
-    /// Number of cells.
-    pub fn len(&self) -> usize {
-        self.n * self.n
-    }
-    /// True for an empty grid.
-    pub fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-}
 
 /// The kernel spectra an operator holds, on the `2N x 2N` wrap-around grid.
 ///
@@ -231,13 +197,6 @@ pub struct Operator {
     /// by the destinations' spectra.
     work: [Vec<Complex64>; 2],
     tangential_bound: f64,
-    /// Coarse `K_zz` levels for nested initial guesses (finest first).
-    coarse: Vec<CoarseLevel>,
-    /// Fourier preconditioner of the normal iteration on this grid, made on
-    /// first use (a window operator, which serves tangential solves, never needs it).
-    precond: Option<FourierPrecond>,
-    /// The operator of the last contact window asked for (see [`Operator::window`]).
-    window: Option<Box<Operator>>,
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian
@@ -342,23 +301,9 @@ impl Operator {
         fits.then(|| Self::with_fft(grid, Fft2::new(grid.n), spectra))
     }
 
-    fn with_fft(grid: Grid, mut fft: Fft2, spectra: Spectra) -> Self {
-        let slen = fft.spectrum_len();
-        // The real K_zz table, transiently, for the Galerkin coarse levels.
-        let mut zz = vec![Complex64::default(); slen];
-        spectra.component(Z, Z).write_complex(&mut zz);
-        let m = fft.padded_len();
-        let mut table = vec![0.0; m * m];
-        fft.inverse_full(&mut zz, &mut table);
-        drop(zz);
-        let coarse = coarse_levels(grid, &table);
-        drop(table);
-        Self::assemble(grid, fft, spectra, coarse)
-    }
-
     /// An operator from its parts; work spectra and the tangential bound
-    /// follow from them, the preconditioner and a window come on first use.
-    fn assemble(grid: Grid, fft: Fft2, spectra: Spectra, coarse: Vec<CoarseLevel>) -> Self {
+    /// follow from them.
+    fn with_fft(grid: Grid, fft: Fft2, spectra: Spectra) -> Self {
         let slen = fft.spectrum_len();
         Operator {
             grid,
@@ -366,43 +311,34 @@ impl Operator {
             fft,
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
-            coarse,
-            precond: None,
-            window: None,
         }
+    }
+
+    /// The real `K_zz` table on the `2N x 2N` wrap-around grid (layout of
+    /// [`Operator::tables`]), by one inverse transform of its stored spectrum:
+    /// what the normal solver's Galerkin coarse levels are made from.
+    pub fn zz_table(&mut self) -> Vec<f64> {
+        let mut zz = vec![Complex64::default(); self.fft.spectrum_len()];
+        self.spectra.component(Z, Z).write_complex(&mut zz);
+        let m = self.fft.padded_len();
+        let mut table = vec![0.0; m * m];
+        self.fft.inverse_full(&mut zz, &mut table);
+        table
     }
 
     /// The operator of an `nw x nw` window of this grid (same cells, `nw ≤ N`):
     /// the same influence coefficients for offsets below `nw` cells, on the
-    /// smaller `2nw x 2nw` wrap-around grid. Fields that vanish outside a
-    /// window (tractions on the contact cells) are applied exactly by it, and
-    /// its transforms cost `(nw/N)²` of this grid's. The last window is kept;
-    /// one of a different size replaces it.
-    pub fn window(&mut self, nw: usize) -> &mut Operator {
+    /// smaller `2nw x 2nw` wrap-around grid, taken from this operator's
+    /// spectra by one inverse transform per stored component (no
+    /// re-integration). Fields that vanish outside a window (tractions on the
+    /// contact cells) are applied exactly by it, and its transforms cost
+    /// `(nw/N)²` of this grid's.
+    pub fn window_operator(&mut self, nw: usize) -> Operator {
         assert!(
             nw >= 1 && nw <= self.grid.n,
             "window {nw} on a {} grid",
             self.grid.n
         );
-        if self.window.as_ref().map(|w| w.grid.n) != Some(nw) {
-            // Free the old window before building the new one (lower peak).
-            self.window = None;
-            self.window = Some(Box::new(self.build_window(nw)));
-        }
-        self.window.as_mut().expect("set above")
-    }
-
-    /// Frees the window operator kept, if any.
-    pub fn drop_window(&mut self) {
-        self.window = None;
-    }
-
-    /// The side of the window operator kept, if any.
-    pub fn window_len(&self) -> Option<usize> {
-        self.window.as_ref().map(|w| w.grid.n)
-    }
-
-    fn build_window(&mut self, nw: usize) -> Operator {
         let grid = Grid { n: nw, ..self.grid };
         let m = self.fft.padded_len();
         let mw = 2 * nw;
@@ -433,8 +369,7 @@ impl Operator {
             out.push(w);
         }
         drop((spec, table));
-        // A window serves tangential solves: no coarse levels.
-        Self::assemble(grid, fft, Spectra::from_stored(out), Vec::new())
+        Self::with_fft(grid, fft, Spectra::from_stored(out))
     }
 
     /// The kernel spectra held (what a kernel store persists).
@@ -524,18 +459,6 @@ impl Operator {
             sum += weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col]);
         }
         sum / (m as f64 * m as f64)
-    }
-
-    /// The Fourier preconditioner of the normal iteration.
-    pub fn precond_mut(&mut self) -> &mut FourierPrecond {
-        let grid = self.grid;
-        self.precond
-            .get_or_insert_with(|| FourierPrecond::new(grid))
-    }
-
-    /// The coarse `K_zz` levels below this grid (finest first).
-    pub fn coarse_levels_mut(&mut self) -> &mut [CoarseLevel] {
-        &mut self.coarse
     }
 
     /// Upper bound of the largest eigenvalue of the tangential block (m/Pa),
@@ -644,7 +567,10 @@ mod tests {
     }
 
     fn cu111_cell(grid: Grid) -> impl Fn(f64, f64) -> Block {
-        crate::case::cell_influence(&crate::presets::material("Cu(111)").unwrap(), grid)
+        crate::presets::material("Cu(111)")
+            .unwrap()
+            .model()
+            .cell_influence(grid)
     }
 
     #[test]

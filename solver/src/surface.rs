@@ -4,7 +4,7 @@
 //! and the initial separation `h0` are assembled in `case`.
 
 use crate::error::SolverError;
-use crate::operator::Grid;
+use crate::grid::Grid;
 use serde::{Deserialize, Serialize};
 
 /// Island shape of a patterned surface.
@@ -98,22 +98,22 @@ impl Surface {
                 offset,
                 ..
             } => {
-                positive("pitch_um", *pitch, "the lattice pitch")?;
+                positive("pitch", *pitch, "the lattice pitch")?;
                 if !height.is_finite() {
                     return Err(SolverError::invalid(
-                        "height_um",
+                        "height",
                         "the island height must be finite",
                     ));
                 }
                 if !(offset[0].is_finite() && offset[1].is_finite()) {
                     return Err(SolverError::invalid(
-                        "offset_um",
+                        "offset",
                         "the lattice offset must be finite",
                     ));
                 }
                 let (name, size, reach) = match island {
-                    Island::Circle { diameter } => ("diameter_um", *diameter, *diameter),
-                    Island::Square { side } => ("side_um", *side, *side * std::f64::consts::SQRT_2),
+                    Island::Circle { diameter } => ("diameter", *diameter, *diameter),
+                    Island::Square { side } => ("side", *side, *side * std::f64::consts::SQRT_2),
                 };
                 positive(name, size, "the island size")?;
                 // Islands must not touch their nearest neighbours (side-by-side for
@@ -142,17 +142,17 @@ impl Surface {
                 angle_deg,
                 offset,
             } => {
-                positive("pitch_um", *pitch, "the stripe pitch")?;
-                positive("width_um", *width, "the stripe width")?;
+                positive("pitch", *pitch, "the stripe pitch")?;
+                positive("width", *width, "the stripe width")?;
                 if width >= pitch {
                     return Err(SolverError::invalid(
-                        "width_um",
+                        "width",
                         format!("the stripe width ({width:.3e} m) must be below the pitch ({pitch:.3e} m)"),
                     ));
                 }
                 if !(height.is_finite() && angle_deg.is_finite() && offset.is_finite()) {
                     return Err(SolverError::invalid(
-                        "height_um",
+                        "height",
                         "stripe height, angle and offset must be finite",
                     ));
                 }
@@ -161,7 +161,7 @@ impl Surface {
             Surface::Heightmap { n: hn, heights } => {
                 if *hn != n || heights.len() != n * n {
                     return Err(SolverError::invalid(
-                        "file",
+                        "heights",
                         format!(
                             "the height map is {hn} x {hn} ({} values) but the grid is {n} x {n}",
                             heights.len()
@@ -170,7 +170,7 @@ impl Surface {
                 }
                 if let Some(i) = heights.iter().position(|h| !h.is_finite()) {
                     return Err(SolverError::invalid(
-                        "file",
+                        "heights",
                         format!(
                             "the height map has a non-finite value at row {}, column {}",
                             i / n,
@@ -377,7 +377,7 @@ mod tests {
                     offset: [0.0, 0.0],
                     lattice: LatticeKind::Hexagonal,
                 },
-                "side_um",
+                "side",
             ),
             (
                 Surface::Stripes {
@@ -387,14 +387,14 @@ mod tests {
                     angle_deg: 0.0,
                     offset: 0.0,
                 },
-                "width_um",
+                "width",
             ),
             (
                 Surface::Heightmap {
                     n: 8,
                     heights: vec![0.0; 64],
                 },
-                "file",
+                "heights",
             ),
             (
                 Surface::Heightmap {
@@ -405,7 +405,7 @@ mod tests {
                         v
                     },
                 },
-                "file",
+                "heights",
             ),
         ];
         for (s, field) in bad {

@@ -11,6 +11,7 @@
 
 use crate::error::SolverError;
 use crate::operator::Operator;
+use crate::window::{contact_window, WindowCache};
 
 /// Convergence report of one tangential solve.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -58,7 +59,24 @@ pub struct TangentialSolution {
     pub report: TangentialReport,
 }
 
+/// Where the iteration of a tangential solve starts: the explicit starting
+/// state of the solver. A load history (fretting) starts each increment from
+/// the previous increment's tractions and measures the slip of the increment
+/// by passing the previous state's tangential displacement, negated, in
+/// [`TangentialProblem::extra`]; one monotonic step from rest uses
+/// [`TangentialStart::Proportional`].
+#[derive(Clone, Copy, Debug, Default)]
+pub enum TangentialStart<'a> {
+    /// From rest: tractions proportional to the pressure, `q = F p / P`.
+    #[default]
+    Proportional,
+    /// From given tractions `(qx, qy)`, Pa (e.g. the previous pass of the
+    /// coupling loop, or the previous increment of a load history).
+    Tractions(&'a [f64], &'a [f64]),
+}
+
 /// Inputs of a tangential solve.
+#[derive(Clone, Copy, Debug)]
 pub struct TangentialProblem<'a> {
     /// Pressure (fixed), Pa.
     pub p: &'a [f64],
@@ -73,8 +91,8 @@ pub struct TangentialProblem<'a> {
     pub tolerance: f64,
     /// Iteration budget.
     pub max_iterations: usize,
-    /// Warm start (qx, qy).
-    pub q_init: Option<(&'a [f64], &'a [f64])>,
+    /// Starting state of the iteration.
+    pub start: TangentialStart<'a>,
 }
 
 /// `|(x, y)|` without `hypot`'s overflow guard (tractions and slips are far
@@ -100,18 +118,33 @@ fn slip_field(
     }
 }
 
-/// Exact projection of `z` onto { |q_i| ≤ b_i, Σ q_i = target }: q_i = Π_i(z_i + λ).
-/// `cap` is Σ b_i over `cells` (fixed for a solve, so the caller sums it once).
+/// The feasible set of a solve, { |q_i| ≤ b_i on `cells`, Σ q_i = target }.
+#[derive(Clone, Copy)]
+struct Feasible<'a> {
+    /// The contact cells.
+    cells: &'a [usize],
+    /// Friction bound b_i = μ p_i per cell, Pa.
+    bound: &'a [f64],
+    /// Σ b_i over `cells` (fixed for a solve, so it is summed once).
+    cap: f64,
+    /// Σ q_i required: the force over the cell area, Pa.
+    target: [f64; 2],
+}
+
+/// Exact projection of `z` onto the feasible set: q_i = Π_i(z_i + λ).
 /// Returns `None` if no λ satisfies the force (gross sliding).
 fn project(
     (zx, zy): (&[f64], &[f64]),
-    bound: &[f64],
-    cells: &[usize],
-    cap: f64,
-    target: [f64; 2],
+    set: &Feasible,
     lambda: &mut [f64; 2],
     (qx, qy): (&mut [f64], &mut [f64]),
 ) -> Option<()> {
+    let Feasible {
+        cells,
+        bound,
+        cap,
+        target,
+    } = *set;
     let tnorm = target[0].hypot(target[1]);
     if tnorm >= cap {
         return None;
@@ -199,6 +232,7 @@ fn project(
 /// `(nw/N)²` as large. [`solve_tangential_on_grid`] solves on the whole grid.
 pub fn solve_tangential(
     op: &mut Operator,
+    windows: &mut WindowCache,
     prob: &TangentialProblem,
 ) -> Result<TangentialSolution, SolverError> {
     let n = op.grid().n;
@@ -207,14 +241,20 @@ pub fn solve_tangential(
     };
     let p = win.gather(prob.p);
     let extra = prob.extra.map(|(ex, ey)| (win.gather(ex), win.gather(ey)));
-    let q_init = prob.q_init.map(|(qx, qy)| (win.gather(qx), win.gather(qy)));
+    let q_init = match prob.start {
+        TangentialStart::Tractions(qx, qy) => Some((win.gather(qx), win.gather(qy))),
+        TangentialStart::Proportional => None,
+    };
     let sub = TangentialProblem {
         p: &p,
         extra: extra.as_ref().map(|(x, y)| (&x[..], &y[..])),
-        q_init: q_init.as_ref().map(|(x, y)| (&x[..], &y[..])),
+        start: match &q_init {
+            Some((x, y)) => TangentialStart::Tractions(x, y),
+            None => TangentialStart::Proportional,
+        },
         ..*prob
     };
-    let sol = solve_tangential_on_grid(op.window(win.n), &sub)?;
+    let sol = solve_tangential_on_grid(windows.operator(op, win.n), &sub)?;
     Ok(TangentialSolution {
         qx: win.scatter(&sol.qx, 0.0),
         qy: win.scatter(&sol.qy, 0.0),
@@ -222,92 +262,6 @@ pub fn solve_tangential(
         sy: win.scatter(&sol.sy, 0.0),
         stick: win.scatter(&sol.stick, false),
         ..sol
-    })
-}
-
-/// A square `n x n` window of an `N x N` grid, its first cell at column `x0`, row `y0`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Window {
-    /// Cells per side of the grid.
-    pub grid_n: usize,
-    /// Cells per side of the window.
-    pub n: usize,
-    /// Column of the window's first cell.
-    pub x0: usize,
-    /// Row of the window's first cell.
-    pub y0: usize,
-}
-
-impl Window {
-    /// The window's values of a grid field (row-major).
-    pub fn gather<T: Copy>(&self, field: &[T]) -> Vec<T> {
-        let mut out = Vec::with_capacity(self.n * self.n);
-        for iy in self.y0..self.y0 + self.n {
-            let row = iy * self.grid_n + self.x0;
-            out.extend_from_slice(&field[row..row + self.n]);
-        }
-        out
-    }
-
-    /// A grid field holding `part` on the window and `fill` elsewhere.
-    pub fn scatter<T: Copy>(&self, part: &[T], fill: T) -> Vec<T> {
-        let mut out = vec![fill; self.grid_n * self.grid_n];
-        for (r, iy) in (self.y0..self.y0 + self.n).enumerate() {
-            let row = iy * self.grid_n + self.x0;
-            out[row..row + self.n].copy_from_slice(&part[r * self.n..(r + 1) * self.n]);
-        }
-        out
-    }
-}
-
-/// Smallest window side `≥ side` whose padded transforms are fast: a multiple
-/// of 8 whose quotient has no prime factors but 2, 3 and 7 (8, 16, 24, 32, 48,
-/// 56, 64, 72, 96, 112, 128, ...). Measured with rustfft on the development
-/// machine, padded sizes with a factor 5 or 13 cost more per point (a window of
-/// 120 cells took longer than one of 128, 240 as long as 256).
-fn window_side(side: usize) -> usize {
-    let smooth = |mut k: usize| {
-        for f in [2, 3, 7] {
-            while k.is_multiple_of(f) {
-                k /= f;
-            }
-        }
-        k == 1
-    };
-    let mut k = side.div_ceil(8).max(1);
-    while !smooth(k) {
-        k += 1;
-    }
-    8 * k
-}
-
-/// The window of an `n x n` grid that holds every cell with `p > 0`, or `None`
-/// when such a window would not be clearly smaller than the grid (over 80 %
-/// of its side) or there is no contact. It depends on `p` alone (not on the
-/// window an operator keeps from an earlier solve), so a case's result does
-/// not depend on which cases a worker solved before it.
-pub fn contact_window(n: usize, p: &[f64]) -> Option<Window> {
-    let (mut x0, mut x1, mut y0, mut y1) = (usize::MAX, 0, usize::MAX, 0);
-    for (iy, row) in p.chunks_exact(n).enumerate() {
-        for (ix, _) in row.iter().enumerate().filter(|(_, &v)| v > 0.0) {
-            x0 = x0.min(ix);
-            x1 = x1.max(ix);
-            y0 = y0.min(iy);
-            y1 = y1.max(iy);
-        }
-    }
-    if x0 == usize::MAX {
-        return None;
-    }
-    let wn = window_side((x1 - x0).max(y1 - y0) + 1);
-    if 5 * wn > 4 * n {
-        return None;
-    }
-    Some(Window {
-        grid_n: n,
-        n: wn,
-        x0: x0.min(n - wn),
-        y0: y0.min(n - wn),
     })
 }
 
@@ -337,14 +291,20 @@ pub fn solve_tangential_on_grid(
         });
     }
     let target = [prob.force[0] / da, prob.force[1] / da];
+    let set = Feasible {
+        cells: &cells,
+        bound: &bound,
+        cap,
+        target,
+    };
     let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
     let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
-    match prob.q_init {
-        Some((ix, iy)) => {
+    match prob.start {
+        TangentialStart::Tractions(ix, iy) => {
             zx.copy_from_slice(ix);
             zy.copy_from_slice(iy);
         }
-        None => {
+        TangentialStart::Proportional => {
             for &i in &cells {
                 zx[i] = prob.force[0] / normal * p[i];
                 zy[i] = prob.force[1] / normal * p[i];
@@ -361,16 +321,7 @@ pub fn solve_tangential_on_grid(
     let gross = || SolverError::GrossSliding {
         detail: "no traction field satisfies both the friction discs and the force".into(),
     };
-    project(
-        (&zx, &zy),
-        &bound,
-        &cells,
-        cap,
-        target,
-        &mut lambda,
-        (&mut qx, &mut qy),
-    )
-    .ok_or_else(gross)?;
+    project((&zx, &zy), &set, &mut lambda, (&mut qx, &mut qy)).ok_or_else(gross)?;
 
     let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
     let mut stick = vec![false; len];
@@ -384,10 +335,7 @@ pub fn solve_tangential_on_grid(
     let cg = cg_disc(
         op,
         prob,
-        &cells,
-        &bound,
-        cap,
-        target,
+        &set,
         (&mut qx, &mut qy),
         (&mut sx, &mut sy),
         (&mut zx, &mut zy),
@@ -428,16 +376,7 @@ pub fn solve_tangential_on_grid(
             zx[i] = yx[i] - step * sx[i];
             zy[i] = yy[i] - step * sy[i];
         }
-        project(
-            (&zx, &zy),
-            &bound,
-            &cells,
-            cap,
-            target,
-            &mut lambda,
-            (&mut px, &mut py),
-        )
-        .ok_or_else(gross)?;
+        project((&zx, &zy), &set, &mut lambda, (&mut px, &mut py)).ok_or_else(gross)?;
         // Gradient mapping residual, relative to the rigid shift.
         let shift_norm = (lambda[0].hypot(lambda[1]) / step).max(f64::MIN_POSITIVE);
         let (mut res, mut restart_dot) = (0.0_f64, 0.0);
@@ -565,19 +504,16 @@ const REFRESH: usize = 32;
 /// six padded transforms. The direction sums to zero over the stick cells
 /// (the mean slip is removed and conjugacy restarts when the set changes), so
 /// the rigid shift's change drops out of the step length.
-#[allow(clippy::too_many_arguments)]
 fn cg_disc(
     op: &mut Operator,
     prob: &TangentialProblem,
-    cells: &[usize],
-    bound: &[f64],
-    cap: f64,
-    target: [f64; 2],
+    set: &Feasible,
     (qx, qy): (&mut [f64], &mut [f64]),
     (ux, uy): (&mut [f64], &mut [f64]),
     (zx, zy): (&mut [f64], &mut [f64]),
     lambda: &mut [f64; 2],
 ) -> Result<CgOutcome, SolverError> {
+    let Feasible { cells, bound, .. } = *set;
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
     let (mut tx, mut ty) = (vec![0.0; len], vec![0.0; len]);
@@ -703,17 +639,10 @@ fn cg_disc(
         }
         // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
         let mut l = [0.0; 2];
-        project(
-            (&*zx, &*zy),
-            bound,
-            cells,
-            cap,
-            target,
-            &mut l,
-            (&mut *qx, &mut *qy),
-        )
-        .ok_or_else(|| SolverError::GrossSliding {
-            detail: "no traction field satisfies both the friction discs and the force".into(),
+        project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy)).ok_or_else(|| {
+            SolverError::GrossSliding {
+                detail: "no traction field satisfies both the friction discs and the force".into(),
+            }
         })?;
         // The new stick set, whether it changed, and Δq of the move.
         let mut changed = false;

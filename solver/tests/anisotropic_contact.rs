@@ -6,9 +6,9 @@ mod common;
 
 use common::table_1a_fe;
 use solver::aniso::{cell_influence, AngularKernel};
-use solver::case::{solve_case, KernelCache};
 use solver::influence::isotropic_cell;
-use solver::material::Isotropic;
+use solver::Isotropic;
+use solver::{solve_case, KernelCache};
 
 #[test]
 fn anisotropic_route_with_isotropic_stiffness_equals_closed_forms_on_64x64() {
@@ -34,7 +34,7 @@ fn anisotropic_route_with_isotropic_stiffness_equals_closed_forms_on_64x64() {
     assert!(worst < 1e-6, "{worst:e}");
 }
 
-fn fe111(n: usize, spacing_um: f64, ratio: f64) -> solver::case::CaseSpec {
+fn fe111(n: usize, spacing_um: f64, ratio: f64) -> solver::CaseSpec {
     let mut spec = table_1a_fe(n, spacing_um, true, ratio);
     spec.material = solver::presets::material("Fe(111)").unwrap();
     spec
@@ -91,7 +91,7 @@ fn fe111_normal_contact_follows_hertz_with_indentation_modulus_and_is_threefold(
     );
     assert!((s.normal_force_n / p - 1.0).abs() < 1e-8);
     // Three-fold symmetry of the pressure: p(r, φ) = p(r, φ + 120°) inside the contact.
-    let grid = spec.grid();
+    let grid = spec.grid;
     let mut worst: f64 = 0.0;
     for k in 0..36 {
         let phi = (k as f64 * 10.0).to_radians();

@@ -1,10 +1,10 @@
-//! Validation ladder steps 3–5 and 8 (PHYSICS.md §8): Hertz, Cattaneo–Mindlin,
+//! Validation ladder steps 3–5 and 8 (docs/validation.md): Hertz, Cattaneo–Mindlin,
 //! flat isotropic μa = μ, and equilibrium, on the paper's Table 1a case.
 
 mod common;
 
 use common::table_1a_fe;
-use solver::case::{solve_case, KernelCache};
+use solver::{solve_case, KernelCache};
 
 fn rel(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()
@@ -85,7 +85,7 @@ fn cattaneo_mindlin_uncoupled_then_coupled_on_table_1a() {
     assert!(rel(off.normal_force_n, 20.0) < 1e-8, "Σ p ΔA = P");
     assert!(rel(off.mu_a.unwrap(), 0.28571) < 0.01, "μa = μ");
     // KKT residuals of the returned tractions are within the requested tolerance.
-    let ttol = spec.tangential_tolerance;
+    let ttol = spec.numerics.tangential_tolerance;
     assert!(
         off.tangential.stick_residual < 2.0 * ttol && off.tangential.slip_residual < 2.0 * ttol
     );

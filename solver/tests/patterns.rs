@@ -1,28 +1,31 @@
-//! Micropatterned surfaces and the apparent friction μa (PHYSICS.md §7, ladder
+//! Micropatterned surfaces and the apparent friction μa (docs/validation.md, Patterns; ladder
 //! step 7): vanishing patterns, the paper's Table 1(c) patterns, and the
 //! symmetries μa must have.
 
-use solver::case::{calibrate_k_e, solve_case, CaseOutput, CaseSpec, KernelCache};
-use solver::surface::{Island, LatticeKind, Surface};
+use solver::{calibrate_k_e, solve_case, CaseOutput, CaseSpec, Grid, KernelCache, Load, Numerics};
+use solver::{Island, LatticeKind, Surface};
 
 /// Paper Table 1(c) conditions on `n` cells of `spacing_um`.
 fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64) -> CaseSpec {
     CaseSpec {
         material: solver::presets::material(material).unwrap(),
         surface: solver::presets::surface(surface).unwrap(),
-        grid_points: n,
-        spacing_m: spacing_um * 1e-6,
-        indenter_radius_m: 0.2,
-        normal_force_n: 6000.0,
-        friction: 0.3,
-        tangential_ratio: 0.6,
-        angle_deg: angle,
-        coupling: true,
-        tolerance: 1e-10,
-        tangential_tolerance: 1e-6,
-        max_iterations: 5000,
-        coupling_tolerance: 1e-8,
-        max_coupling_iterations: 50,
+        grid: Grid::square(n, spacing_um * 1e-6),
+        load: Load {
+            indenter_radius_m: 0.2,
+            normal_force_n: 6000.0,
+            friction: 0.3,
+            tangential_ratio: 0.6,
+            angle_deg: angle,
+        },
+        numerics: Numerics {
+            coupling: true,
+            tolerance: 1e-10,
+            tangential_tolerance: 1e-6,
+            max_iterations: 5000,
+            coupling_tolerance: 1e-8,
+            max_coupling_iterations: 50,
+        },
     }
 }
 
@@ -32,7 +35,7 @@ fn solve(spec: &CaseSpec, cache: &mut KernelCache) -> CaseOutput {
     let s = &out.scalars;
     let f = spec.tangential_force();
     assert!(
-        (s.normal_force_n / spec.normal_force_n - 1.0).abs() < 1e-8,
+        (s.normal_force_n / spec.load.normal_force_n - 1.0).abs() < 1e-8,
         "Σ p ΔA = P"
     );
     let fe = (s.tangential_force_n[0] - f[0]).hypot(s.tangential_force_n[1] - f[1]);
@@ -91,8 +94,8 @@ fn table_1c_patterns_contact_island_tops_and_dense_patterns_lower_mu_a() {
         let spec = table_1c("Cu", surface, 192, 40.0, 0.0);
         let out = solve(&spec, &mut cache);
         let s = &out.scalars;
-        let n = spec.grid_points;
-        let h = spec.surface.heights(&spec.grid());
+        let n = spec.grid.n;
+        let h = spec.surface.heights(&spec.grid);
         // Where does the shear traction peak? On an island edge cell.
         let imax = (0..n * n)
             .max_by(|&i, &j| out.fields.qx[i].abs().total_cmp(&out.fields.qx[j].abs()))
@@ -197,7 +200,7 @@ fn flat_111_k_e_has_the_crystal_symmetry() {
     let k_e = |psi: f64, cache: &mut KernelCache| {
         let spec = table_1c("Cu(111)", "flat", 256, 20.0, psi);
         let s = solve(&spec, cache).scalars;
-        calibrate_k_e(&s, spec.friction, spec.normal_force_n)
+        calibrate_k_e(&s, spec.load.friction, spec.load.normal_force_n)
     };
     let (k0, k120, k30, km30, k90) = (
         k_e(0.0, &mut cache),
@@ -222,8 +225,8 @@ fn an_unresolved_slip_zone_is_a_named_error_not_an_infinite_mu_a() {
     // 32² cells of 200 µm: the few contact cells on the circle-A islands all
     // stay below the friction bound at F = 0.3 μP, so a = c.
     let mut spec = table_1c("Ni", "circle-A", 32, 200.0, 0.0);
-    spec.tangential_ratio = 0.3;
-    spec.coupling = false;
+    spec.load.tangential_ratio = 0.3;
+    spec.numerics.coupling = false;
     let err = solve_case(&spec, &mut KernelCache::new()).unwrap_err();
     assert!(
         matches!(err, solver::SolverError::SlipUnresolved { .. }),
@@ -236,8 +239,8 @@ fn an_unresolved_slip_zone_is_a_named_error_not_an_infinite_mu_a() {
     );
     // The same surface resolved finely enough slips at its outline.
     let mut fine = table_1c("Ni", "circle-A", 128, 50.0, 0.0);
-    fine.tangential_ratio = 0.3;
-    fine.coupling = false;
+    fine.load.tangential_ratio = 0.3;
+    fine.numerics.coupling = false;
     let ok = solve_case(&fine, &mut KernelCache::new()).unwrap();
     let s = &ok.scalars;
     assert!(s.stick_radius_m < s.contact_radius_m);

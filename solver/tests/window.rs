@@ -5,14 +5,15 @@
 
 mod common;
 
-use solver::case::{solve_case, KernelCache};
 use solver::operator::{Grid, Operator, X, Y, Z};
 use solver::tangential::{
-    contact_window, solve_tangential, solve_tangential_on_grid, TangentialProblem,
+    solve_tangential, solve_tangential_on_grid, TangentialProblem, TangentialStart,
 };
+use solver::window::{contact_window, Window, WindowCache};
+use solver::{solve_case, KernelCache};
 
 fn cu111(grid: Grid) -> Operator {
-    solver::case::build_operator(&solver::presets::material("Cu(111)").unwrap(), grid)
+    solver::build_operator(&solver::presets::material("Cu(111)").unwrap(), grid)
 }
 
 fn grid(n: usize) -> Grid {
@@ -49,7 +50,7 @@ fn pressure(n: usize, a: f64, cx: f64, cy: f64) -> Vec<f64> {
 fn a_window_operator_applies_fields_inside_it_exactly() {
     let (n, nw, x0, y0) = (40, 24, 13, 3);
     let mut op = cu111(grid(n));
-    let win = solver::tangential::Window {
+    let win = Window {
         grid_n: n,
         n: nw,
         x0,
@@ -74,16 +75,17 @@ fn a_window_operator_applies_fields_inside_it_exactly() {
             &mut [(X, ux), (Y, uy), (Z, uz)],
         );
     }
+    let mut windows = WindowCache::default();
     {
         let [ux, uy, uz] = &mut u_win[..] else {
             unreachable!()
         };
-        op.window(nw).apply(
+        windows.operator(&mut op, nw).apply(
             &[(X, &t[0]), (Y, &t[1]), (Z, &t[2])],
             &mut [(X, ux), (Y, uy), (Z, uz)],
         );
     }
-    assert_eq!(op.window_len(), Some(nw));
+    assert_eq!(windows.side(), Some(nw));
     for (c, (uf, uw)) in u_full.iter().zip(&u_win).enumerate() {
         let want = win.gather(uf);
         let scale = max_abs(&want);
@@ -153,11 +155,12 @@ fn windowed_and_whole_grid_tangential_solves_agree_for_a_111_crystal() {
         extra: Some((&ex, &ey)),
         tolerance: 1e-10,
         max_iterations: 20_000,
-        q_init: None,
+        start: TangentialStart::Proportional,
     };
     let whole = solve_tangential_on_grid(&mut op, &prob).unwrap();
-    let win = solve_tangential(&mut op, &prob).unwrap();
-    assert_eq!(op.window_len(), Some(24), "the 24 x 24 window was used");
+    let mut windows = WindowCache::default();
+    let win = solve_tangential(&mut op, &mut windows, &prob).unwrap();
+    assert_eq!(windows.side(), Some(24), "the 24 x 24 window was used");
     assert!(whole.report.converged && win.report.converged);
     let qs = max_abs(&whole.qx).max(max_abs(&whole.qy));
     let dq = max_diff(&whole.qx, &win.qx).max(max_diff(&whole.qy, &win.qy));
@@ -185,13 +188,13 @@ fn only_the_operator_in_use_keeps_its_window() {
     // Table 1a on 64 cells of 5 µm: contact about 42 cells across, window 48.
     let a = common::table_1a_fe(64, 5.0, false, 0.6);
     let mut b = a.clone();
-    b.material = solver::material::Material::isotropic("Fe-soft", 150.0e9, 0.3).unwrap();
+    b.material = solver::Material::isotropic("Fe-soft", 150.0e9, 0.3).unwrap();
     let mut cache = KernelCache::new();
     let out = solve_case(&a, &mut cache).unwrap();
     assert!(out.scalars.converged);
-    assert_eq!(cache.operator(&a).unwrap().0.window_len(), Some(48));
+    assert_eq!(cache.resident(&a).unwrap().0.windows.side(), Some(48));
     let out = solve_case(&b, &mut cache).unwrap();
     assert!(out.scalars.converged);
-    assert!(cache.operator(&b).unwrap().0.window_len().is_some());
-    assert_eq!(cache.operator(&a).unwrap().0.window_len(), None);
+    assert!(cache.resident(&b).unwrap().0.windows.side().is_some());
+    assert_eq!(cache.resident(&a).unwrap().0.windows.side(), None);
 }

@@ -6,8 +6,7 @@
 //! A file that does not match its key exactly is ignored and rewritten.
 
 use num_complex::Complex64;
-use solver::case::KernelStore;
-use solver::operator::Spectra;
+use solver::{KernelKey, KernelStore, Spectra};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
@@ -39,14 +38,15 @@ impl FileStore {
     }
 
     /// A cache backed by the default store, or a plain in-memory cache.
-    pub fn cache() -> solver::case::KernelCache {
+    pub fn cache() -> solver::KernelCache {
         match Self::default_location() {
-            Some(dir) => solver::case::KernelCache::with_store(Box::new(FileStore::new(dir))),
-            None => solver::case::KernelCache::new(),
+            Some(dir) => solver::KernelCache::with_store(Box::new(FileStore::new(dir))),
+            None => solver::KernelCache::new(),
         }
     }
 
-    fn path(&self, key: &str) -> PathBuf {
+    fn path(&self, key: &KernelKey) -> PathBuf {
+        let key = key.as_str();
         // FNV-1a of the key names the file; the key itself is stored and checked.
         let mut h: u64 = 0xcbf29ce484222325;
         for b in key.bytes() {
@@ -56,7 +56,8 @@ impl FileStore {
         self.dir.join(format!("{h:016x}.kern"))
     }
 
-    fn read(path: &Path, key: &str, len: usize) -> std::io::Result<Option<Spectra>> {
+    fn read(path: &Path, key: &KernelKey, len: usize) -> std::io::Result<Option<Spectra>> {
+        let key = key.as_str();
         let mut f = std::io::BufReader::new(std::fs::File::open(path)?);
         let mut magic = [0u8; 8];
         f.read_exact(&mut magic)?;
@@ -115,14 +116,15 @@ impl FileStore {
 }
 
 impl KernelStore for FileStore {
-    fn load(&self, key: &str, len: usize) -> Option<Spectra> {
+    fn load(&self, key: &KernelKey, len: usize) -> Option<Spectra> {
         Self::read(&self.path(key), key, len).ok().flatten()
     }
 
-    fn save(&self, key: &str, spectra: &Spectra) {
+    fn save(&self, key: &KernelKey, spectra: &Spectra) {
         let write = || -> std::io::Result<()> {
             std::fs::create_dir_all(&self.dir)?;
             let path = self.path(key);
+            let key = key.as_str();
             // Write to a private temporary name, then rename: readers never see half a file.
             let tmp = path.with_extension(format!("tmp{}", std::process::id()));
             {
@@ -158,26 +160,28 @@ impl KernelStore for FileStore {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use solver::case::{solve_case, CaseSpec};
-    use solver::surface::Surface;
+    use solver::{solve_case, CaseSpec, Grid, Load, Numerics, Surface};
 
     fn spec() -> CaseSpec {
         CaseSpec {
             material: solver::presets::material("Cu(111)").unwrap(),
             surface: Surface::Flat,
-            grid_points: 32,
-            spacing_m: 200e-6,
-            indenter_radius_m: 0.2,
-            normal_force_n: 6000.0,
-            friction: 0.3,
-            tangential_ratio: 0.0,
-            angle_deg: 0.0,
-            coupling: false,
-            tolerance: 1e-10,
-            tangential_tolerance: 1e-6,
-            max_iterations: 2000,
-            coupling_tolerance: 1e-8,
-            max_coupling_iterations: 5,
+            grid: Grid::square(32, 200e-6),
+            load: Load {
+                indenter_radius_m: 0.2,
+                normal_force_n: 6000.0,
+                friction: 0.3,
+                tangential_ratio: 0.0,
+                angle_deg: 0.0,
+            },
+            numerics: Numerics {
+                coupling: false,
+                tolerance: 1e-10,
+                tangential_tolerance: 1e-6,
+                max_iterations: 2000,
+                coupling_tolerance: 1e-8,
+                max_coupling_iterations: 5,
+            },
         }
     }
 
@@ -185,12 +189,10 @@ mod tests {
     fn second_cache_loads_the_stored_kernel_and_gives_identical_results() {
         let dir = std::env::temp_dir().join(format!("mpcontact-kstore-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let mut first =
-            solver::case::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
+        let mut first = solver::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
         let a = solve_case(&spec(), &mut first).unwrap();
         assert_eq!((first.builds(), first.loads()), (1, 0));
-        let mut second =
-            solver::case::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
+        let mut second = solver::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
         let b = solve_case(&spec(), &mut second).unwrap();
         assert_eq!((second.builds(), second.loads()), (1, 1));
         assert_eq!(
@@ -206,8 +208,7 @@ mod tests {
             .path();
         let bytes = std::fs::read(&file).unwrap();
         std::fs::write(&file, &bytes[..bytes.len() / 2]).unwrap();
-        let mut third =
-            solver::case::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
+        let mut third = solver::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
         let c = solve_case(&spec(), &mut third).unwrap();
         assert_eq!(third.loads(), 0);
         assert_eq!(a.fields.p, c.fields.p);

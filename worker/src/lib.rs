@@ -4,7 +4,7 @@
 //! `<run>/work` pull queue, announces itself, solves the cases it is sent
 //! with operators kept resident per (material, grid), and returns scalars
 //! (and fields when asked) in shared memory. A thin shell around
-//! [`solver::case::solve_case`]; all names and the wire format come from
+//! [`solver::solve_case`]; all names and the wire format come from
 //! `protocol`.
 //!
 //! It exits cleanly when the coordinator answers `Done`, and on its own when
@@ -26,7 +26,7 @@ use protocol::{
     FIELD_NAMES,
 };
 use serde::{Deserialize, Serialize};
-use solver::case::{solve_case, CaseScalars, CaseSpec, KernelCache};
+use solver::{solve_case, CaseScalars, CaseSpec, KernelCache, KernelKey};
 
 /// Case specification as it travels on the wire.
 pub type WireSpec = CaseSpec;
@@ -94,12 +94,12 @@ enum Answer {
 pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
     let w = attach(run_id, worker_index)?;
     let mut cache = kernel_store::FileStore::cache();
-    let mut keys: HashSet<String> = HashSet::new();
+    let mut keys: HashSet<KernelKey> = HashSet::new();
     let mut next: WorkerMessage = ToCoord::Ready(Ready {
         worker_index: worker_index as u32,
         pid: std::process::id(),
     });
-    let mut fields_buf: Option<solver::case::Fields> = None;
+    let mut fields_buf: Option<solver::Fields> = None;
     loop {
         let pending = w.send(&next, fields_buf.as_ref())?;
         let answer = match w.wait_answer(&pending)? {
@@ -173,10 +173,10 @@ fn solve_one(
     case: &CaseAssignment<WireSpec>,
     worker_index: usize,
     cache: &mut KernelCache,
-    keys: &mut HashSet<String>,
-) -> (WorkerMessage, Option<solver::case::Fields>) {
+    keys: &mut HashSet<KernelKey>,
+) -> (WorkerMessage, Option<solver::Fields>) {
     let start = Instant::now();
-    keys.insert(case.spec.kernel_key());
+    keys.insert(KernelKey::of(&case.spec));
     let solved = solve_case(&case.spec, cache);
     let solve_seconds = start.elapsed().as_secs_f64();
     match solved {
@@ -269,7 +269,7 @@ impl Attached {
     fn send(
         &self,
         msg: &WorkerMessage,
-        fields: Option<&solver::case::Fields>,
+        fields: Option<&solver::Fields>,
     ) -> anyhow::Result<Pending> {
         let mut msg = msg.clone();
         if let ToCoord::Result(h) = &mut msg {
@@ -353,33 +353,35 @@ impl Attached {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use solver::material::Material;
-    use solver::surface::Surface;
+    use solver::{Grid, Load, Material, Numerics, Surface};
 
     fn spec(material: &str, youngs: f64, angle: f64) -> CaseSpec {
         CaseSpec {
             material: Material::isotropic(material, youngs, 0.3).unwrap(),
             surface: Surface::Flat,
-            grid_points: 16,
-            spacing_m: 400e-6,
-            indenter_radius_m: 0.2,
-            normal_force_n: 6000.0,
-            friction: 0.3,
-            tangential_ratio: 0.0,
-            angle_deg: angle,
-            coupling: false,
-            tolerance: 1e-8,
-            tangential_tolerance: 1e-6,
-            max_iterations: 2000,
-            coupling_tolerance: 1e-6,
-            max_coupling_iterations: 5,
+            grid: Grid::square(16, 400e-6),
+            load: Load {
+                indenter_radius_m: 0.2,
+                normal_force_n: 6000.0,
+                friction: 0.3,
+                tangential_ratio: 0.0,
+                angle_deg: angle,
+            },
+            numerics: Numerics {
+                coupling: false,
+                tolerance: 1e-8,
+                tangential_tolerance: 1e-6,
+                max_iterations: 2000,
+                coupling_tolerance: 1e-6,
+                max_coupling_iterations: 5,
+            },
         }
     }
 
     fn assignment(id: &str, spec: CaseSpec, want_fields: bool) -> CaseAssignment<WireSpec> {
         CaseAssignment {
             case_id: id.into(),
-            grid_n: spec.grid_points as u32,
+            grid_n: spec.grid.n as u32,
             want_fields,
             attempt: 0,
             spec,
@@ -453,7 +455,7 @@ mod tests {
         let mut cache = KernelCache::new();
         let mut keys = HashSet::new();
         let mut s = spec("A", 130e9, 0.0);
-        s.tangential_ratio = 1.5;
+        s.load.tangential_ratio = 1.5;
         let (msg, _) = solve_one(
             &assignment("A/flat/000.0", s, false),
             0,

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
-use solver::case::CaseScalars;
+use solver::CaseScalars;
 
 /// File name inside the output directory.
 pub const JOURNAL_FILE: &str = "journal.jsonl";

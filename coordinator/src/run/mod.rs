@@ -209,8 +209,8 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         resumed,
         workers: args.workers,
         started_unix_s,
-        apparent_radius_definition: solver::case::APPARENT_RADIUS_DEFINITION,
-        k_e_definition: solver::case::K_E_DEFINITION,
+        apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
+        k_e_definition: solver::K_E_DEFINITION,
         ..Default::default()
     };
 

@@ -9,8 +9,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use solver::case::{calibrate_k_e, mu_apparent, CaseScalars};
-use solver::surface::Surface;
+use solver::{calibrate_on_flat, CaseScalars};
 
 use super::journal::Record;
 use super::plan::PlannedCase;
@@ -69,23 +68,15 @@ pub fn calibrate<'a>(
         let mut scalars = record.scalars.clone();
         if let Some(s) = scalars.as_mut() {
             let spec = &case.spec;
-            if !spec.material.is_isotropic() && spec.tangential_ratio > 0.0 {
-                let twin = cases.iter().find(|c| {
-                    matches!(c.spec.surface, Surface::Flat)
-                        && c.spec.material == spec.material
-                        && c.spec.grid_points == spec.grid_points
-                        && c.spec.spacing_m.to_bits() == spec.spacing_m.to_bits()
-                        && c.spec.angle_deg.to_bits() == spec.angle_deg.to_bits()
-                });
+            if spec.needs_flat_calibration() {
+                let twin_spec = spec.flat_twin();
+                let twin = cases.iter().find(|c| c.spec == twin_spec);
                 let flat = twin
                     .and_then(|t| records.get(&t.id))
                     .filter(|r| r.status != "failed")
                     .and_then(|r| r.scalars.as_ref());
                 if let Some(flat) = flat {
-                    let k_e = calibrate_k_e(flat, spec.friction, spec.normal_force_n);
-                    s.k_e = k_e;
-                    s.k_e_source = "flat-calibrated".into();
-                    s.mu_a = Some(mu_apparent(s, spec.normal_force_n, k_e));
+                    calibrate_on_flat(s, flat, &spec.load);
                 }
             }
         }
@@ -117,7 +108,7 @@ pub fn results_csv(rows: &[Row]) -> String {
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{}",
             csv_field(&c.spec.material.name),
             csv_field(&surface_name(c)),
-            fmt_f64(c.spec.angle_deg),
+            fmt_f64(c.spec.load.angle_deg),
             r.record.status,
             opt(s.and_then(|s| s.mu_a)),
             f(|s| s.k_e),
@@ -164,7 +155,7 @@ pub fn curves_csv(rows: &[Row]) -> String {
             "{},{},{},{}",
             csv_field(&r.case.spec.material.name),
             csv_field(&surface_name(r.case)),
-            fmt_f64(r.case.spec.angle_deg),
+            fmt_f64(r.case.spec.load.angle_deg),
             fmt_f64(mu)
         );
     }
@@ -181,7 +172,7 @@ pub fn curves(rows: &[Row]) -> BTreeMap<String, Vec<(f64, f64)>> {
             surface_name(r.case)
         ))
         .or_default()
-        .push((r.case.spec.angle_deg, mu));
+        .push((r.case.spec.load.angle_deg, mu));
     }
     for v in m.values_mut() {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -289,6 +280,7 @@ pub fn fields_dir(out_dir: &Path, case_id: &str) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use solver::{calibrate_k_e, mu_apparent, CaseSpec, Surface};
 
     #[test]
     fn float_text_is_shortest_round_trip() {
@@ -301,29 +293,32 @@ mod tests {
     }
 
     fn aniso_case(id: &str, surface: Surface) -> PlannedCase {
-        let iso = solver::material::Isotropic::new(130e9, 0.34).unwrap();
+        let iso = solver::Isotropic::new(130e9, 0.34).unwrap();
         let mut c = iso.stiffness();
         c[(0, 0)] *= 1.2;
-        let spec = solver::case::CaseSpec {
-            material: solver::material::Material {
+        let spec = CaseSpec {
+            material: solver::Material {
                 name: "Cu(111)".into(),
-                elasticity: solver::material::Elasticity::Anisotropic(c),
+                elasticity: solver::Elasticity::Anisotropic(solver::Anisotropic(c)),
                 equivalent: iso,
             },
             surface,
-            grid_points: 32,
-            spacing_m: 1e-4,
-            indenter_radius_m: 0.2,
-            normal_force_n: 6000.0,
-            friction: 0.3,
-            tangential_ratio: 0.6,
-            angle_deg: 30.0,
-            coupling: false,
-            tolerance: 1e-8,
-            tangential_tolerance: 1e-6,
-            max_iterations: 100,
-            coupling_tolerance: 1e-6,
-            max_coupling_iterations: 5,
+            grid: solver::Grid::square(32, 1e-4),
+            load: solver::Load {
+                indenter_radius_m: 0.2,
+                normal_force_n: 6000.0,
+                friction: 0.3,
+                tangential_ratio: 0.6,
+                angle_deg: 30.0,
+            },
+            numerics: solver::Numerics {
+                coupling: false,
+                tolerance: 1e-8,
+                tangential_tolerance: 1e-6,
+                max_iterations: 100,
+                coupling_tolerance: 1e-6,
+                max_coupling_iterations: 5,
+            },
         };
         let mut plan = super::super::plan::Plan::new(vec![(id.to_string(), spec)]);
         plan.cases.remove(0)
@@ -351,11 +346,11 @@ mod tests {
     #[test]
     fn anisotropic_mu_a_uses_k_e_from_the_flat_twin() {
         let lattice = Surface::Lattice {
-            island: solver::surface::Island::Circle { diameter: 4e-4 },
+            island: solver::Island::Circle { diameter: 4e-4 },
             pitch: 1.28e-3,
             height: 3e-5,
             offset: [0.0, 0.0],
-            lattice: solver::surface::LatticeKind::Square,
+            lattice: solver::LatticeKind::Square,
         };
         let flat = aniso_case("Cu(111)/flat/030.0", Surface::Flat);
         let pat = aniso_case("Cu(111)/circle-A/030.0", lattice);

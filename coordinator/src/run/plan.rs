@@ -3,8 +3,7 @@
 
 use std::collections::HashSet;
 
-use solver::case::CaseSpec;
-use solver::surface::Surface;
+use solver::{CaseSpec, KernelKey, Surface};
 
 /// Where a case stands.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,8 +28,8 @@ pub struct PlannedCase {
     pub id: String,
     /// Its specification.
     pub spec: CaseSpec,
-    /// Operator identity, [`CaseSpec::kernel_key`].
-    pub kernel_key: String,
+    /// The kernel it needs.
+    pub kernel_key: KernelKey,
     /// A flat case of an anisotropic material: its K_E(ψ) calibrates the
     /// patterned cases at the same angle, so it is dispatched first.
     pub calibration: bool,
@@ -58,7 +57,7 @@ impl Plan {
         let cases = cases
             .into_iter()
             .map(|(id, spec)| PlannedCase {
-                kernel_key: spec.kernel_key(),
+                kernel_key: KernelKey::of(&spec),
                 calibration: is_calibration(&spec),
                 id,
                 spec,
@@ -94,7 +93,7 @@ impl Plan {
     /// workers hold `others`: calibration cases first; within a class, a case
     /// whose kernel the worker already has, else one whose kernel nobody has,
     /// else any (no worker idles while cases remain).
-    pub fn pick(&self, own: &HashSet<String>, others: &HashSet<String>) -> Option<usize> {
+    pub fn pick(&self, own: &HashSet<KernelKey>, others: &HashSet<KernelKey>) -> Option<usize> {
         let pending = |c: &&PlannedCase| c.state == CaseState::Pending;
         let class = if self.cases.iter().filter(pending).any(|c| c.calibration) {
             |c: &PlannedCase| c.calibration
@@ -118,25 +117,28 @@ impl Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use solver::material::Material;
+    use solver::{Grid, Load, Material, Numerics};
 
     fn spec(material: &str, angle: f64) -> CaseSpec {
         CaseSpec {
             material: Material::isotropic(material, 100e9, 0.3).unwrap(),
             surface: Surface::Flat,
-            grid_points: 32,
-            spacing_m: 1e-5,
-            indenter_radius_m: 0.2,
-            normal_force_n: 100.0,
-            friction: 0.3,
-            tangential_ratio: 0.5,
-            angle_deg: angle,
-            coupling: false,
-            tolerance: 1e-8,
-            tangential_tolerance: 1e-6,
-            max_iterations: 100,
-            coupling_tolerance: 1e-6,
-            max_coupling_iterations: 5,
+            grid: Grid::square(32, 1e-5),
+            load: Load {
+                indenter_radius_m: 0.2,
+                normal_force_n: 100.0,
+                friction: 0.3,
+                tangential_ratio: 0.5,
+                angle_deg: angle,
+            },
+            numerics: Numerics {
+                coupling: false,
+                tolerance: 1e-8,
+                tangential_tolerance: 1e-6,
+                max_iterations: 100,
+                coupling_tolerance: 1e-6,
+                max_coupling_iterations: 5,
+            },
         }
     }
 
@@ -154,7 +156,7 @@ mod tests {
         let p = plan();
         let first = p.pick(&HashSet::new(), &HashSet::new()).unwrap();
         assert_eq!(first, 0);
-        let a: HashSet<String> = [p.cases[0].kernel_key.clone()].into();
+        let a: HashSet<KernelKey> = [p.cases[0].kernel_key.clone()].into();
         let second = p.pick(&HashSet::new(), &a).unwrap();
         assert_eq!(p.cases[second].id, "B/flat/000.0");
     }
@@ -163,29 +165,30 @@ mod tests {
     fn calibration_cases_go_first() {
         let mut aniso = spec("C", 0.0);
         let iso = aniso.material.equivalent;
-        aniso.material.elasticity = solver::material::Elasticity::Anisotropic(iso.stiffness());
+        aniso.material.elasticity =
+            solver::Elasticity::Anisotropic(solver::Anisotropic(iso.stiffness()));
         let mut patterned = aniso.clone();
         patterned.surface = Surface::Lattice {
-            island: solver::surface::Island::Circle { diameter: 4e-4 },
+            island: solver::Island::Circle { diameter: 4e-4 },
             pitch: 1.28e-3,
             height: 3e-5,
             offset: [0.0, 0.0],
-            lattice: solver::surface::LatticeKind::Square,
+            lattice: solver::LatticeKind::Square,
         };
         let p = Plan::new(vec![
             ("A/flat/000.0".into(), spec("A", 0.0)),
             ("C/circle-A/000.0".into(), patterned),
             ("C/flat/000.0".into(), aniso),
         ]);
-        let own: HashSet<String> = [p.cases[0].kernel_key.clone()].into();
+        let own: HashSet<KernelKey> = [p.cases[0].kernel_key.clone()].into();
         assert_eq!(p.pick(&own, &HashSet::new()), Some(2));
     }
 
     #[test]
     fn worker_keeps_its_material_and_never_idles() {
         let mut p = plan();
-        let a: HashSet<String> = [p.cases[0].kernel_key.clone()].into();
-        let b: HashSet<String> = [p.cases[2].kernel_key.clone()].into();
+        let a: HashSet<KernelKey> = [p.cases[0].kernel_key.clone()].into();
+        let b: HashSet<KernelKey> = [p.cases[2].kernel_key.clone()].into();
         p.cases[0].state = CaseState::Done;
         assert_eq!(p.pick(&a, &b), Some(1));
         p.cases[1].state = CaseState::Done;

@@ -40,7 +40,7 @@ struct Slot {
     registered: bool,
     held: Option<Active>,
     in_flight: Option<usize>,
-    keys: HashSet<String>,
+    keys: HashSet<solver::KernelKey>,
     stats: WorkerSummary,
     dead: bool,
     done_sent: bool,
@@ -391,7 +391,7 @@ impl<'a> Session<'a> {
             return Ok(());
         }
         let want_fields = self.args.save_fields;
-        let n = plan.cases[i].spec.grid_points as u32;
+        let n = plan.cases[i].spec.grid.n as u32;
         if let Err(e) = protocol::validate_result(&h, field_bytes, |_| {
             Some(Expected {
                 grid_n: n,
@@ -519,7 +519,7 @@ impl<'a> Session<'a> {
     /// Answer `active` from worker `k` with a case, `Done`, or hold it.
     /// Returns whether something was sent.
     fn assign(&mut self, plan: &mut Plan, k: usize, active: Active) -> anyhow::Result<bool> {
-        let others: HashSet<String> = self
+        let others: HashSet<solver::KernelKey> = self
             .slots
             .iter()
             .filter(|(j, s)| **j != k && !s.dead)
@@ -532,7 +532,7 @@ impl<'a> Session<'a> {
             let case = &mut plan.cases[i];
             let msg = ToWorker::Case(CaseAssignment {
                 case_id: case.id.clone(),
-                grid_n: case.spec.grid_points as u32,
+                grid_n: case.spec.grid.n as u32,
                 want_fields: self.args.save_fields,
                 attempt: case.attempts,
                 spec: case.spec.clone(),

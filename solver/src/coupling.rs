@@ -1,0 +1,274 @@
+//! Partial slip under a tangential force, with or without normal–tangential
+//! coupling: the tangential solve at the current pressure, and (coupled) the
+//! fixed-point loop between it and the normal solve with the tangential
+//! tractions' normal displacement as an extra gap, accelerated by Anderson
+//! mixing while far from converged. Knows the case's load and numerics, and
+//! the solvers through a [`Resident`] bundle; reduces nothing to scalars.
+
+use std::collections::VecDeque;
+
+use crate::error::SolverError;
+use crate::kernels::Resident;
+use crate::normal::{NormalProblem, NormalReport, NormalSolution};
+use crate::operator::{X, Y, Z};
+use crate::spec::CaseSpec;
+use crate::tangential::{TangentialProblem, TangentialReport, TangentialStart};
+
+/// History depth of the Anderson mixing of the coupling loop.
+const ANDERSON_DEPTH: usize = 3;
+
+/// Anderson acceleration (type II) of a fixed point `x = G(x)`: given
+/// `g = G(x_prev)`, replaces it by `g − ΔG γ` with `γ` minimising
+/// `|f − ΔF γ|`, `f = g − x_prev`, over the last `depth` differences.
+struct Anderson {
+    depth: usize,
+    x_prev: Vec<f64>,
+    last: Option<(Vec<f64>, Vec<f64>)>,
+    dg: VecDeque<Vec<f64>>,
+    df: VecDeque<Vec<f64>>,
+}
+
+impl Anderson {
+    fn new(depth: usize, len: usize) -> Self {
+        Anderson {
+            depth,
+            x_prev: vec![0.0; len],
+            last: None,
+            dg: Default::default(),
+            df: Default::default(),
+        }
+    }
+
+    fn reset(&mut self) {
+        self.last = None;
+        self.dg.clear();
+        self.df.clear();
+    }
+
+    /// `g` holds G(x_prev) on entry and the next iterate on return.
+    fn mix(&mut self, g: &mut [f64]) {
+        let f: Vec<f64> = g.iter().zip(&self.x_prev).map(|(a, b)| a - b).collect();
+        if let Some((g_old, f_old)) = self.last.take() {
+            if self.dg.len() == self.depth {
+                self.dg.pop_front();
+                self.df.pop_front();
+            }
+            self.dg
+                .push_back(g.iter().zip(&g_old).map(|(a, b)| a - b).collect());
+            self.df
+                .push_back(f.iter().zip(&f_old).map(|(a, b)| a - b).collect());
+        }
+        let next_last = (g.to_vec(), f.clone());
+        let m = self.df.len();
+        if m > 0 {
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+            let a = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&self.df[i], &self.df[j]));
+            let b = nalgebra::DVector::from_fn(m, |i, _| dot(&self.df[i], &f));
+            let reg = 1e-12 * a.trace().max(f64::MIN_POSITIVE);
+            let a = a + nalgebra::DMatrix::identity(m, m) * reg;
+            if let Some(gamma) = a.cholesky().map(|c| c.solve(&b)) {
+                if gamma.iter().all(|v| v.is_finite()) {
+                    for (j, dgj) in self.dg.iter().enumerate() {
+                        for (gi, d) in g.iter_mut().zip(dgj) {
+                            *gi -= gamma[j] * d;
+                        }
+                    }
+                }
+            }
+        }
+        self.last = Some(next_last);
+        self.x_prev.copy_from_slice(g);
+    }
+}
+
+/// Tractions, slip and convergence of a case after its partial-slip solve.
+pub(crate) struct ContactState {
+    /// Pressure, Pa.
+    pub p: Vec<f64>,
+    /// Shear tractions, Pa.
+    pub qx: Vec<f64>,
+    /// Shear tractions, Pa.
+    pub qy: Vec<f64>,
+    /// Slip, m.
+    pub sx: Vec<f64>,
+    /// Slip, m.
+    pub sy: Vec<f64>,
+    /// Stick cells (all contact cells without a tangential force).
+    pub stick: Vec<bool>,
+    /// Rigid tangential shift δt, m.
+    pub shift: [f64; 2],
+    /// Rigid-body approach δz, m.
+    pub approach: f64,
+    /// Report of the last normal solve.
+    pub normal_report: NormalReport,
+    /// Report of the last tangential solve.
+    pub tangential_report: TangentialReport,
+    /// Normal iterations, summed over coupling passes.
+    pub normal_iterations: usize,
+    /// Tangential iterations, summed over coupling passes.
+    pub tangential_iterations: usize,
+    /// Coupling passes (0 without a tangential force).
+    pub coupling_iterations: usize,
+    /// Last relative change of p between coupling passes.
+    pub coupling_change: f64,
+    /// The coupling loop converged (true when uncoupled).
+    pub coupling_converged: bool,
+}
+
+/// Solves the tangential problem of `spec` (and, coupled, the coupling loop)
+/// from the normal solution `normal0` of the separation `h0`.
+pub(crate) fn solve_partial_slip(
+    res: &mut Resident,
+    spec: &CaseSpec,
+    h0: &[f64],
+    normal0: NormalSolution,
+) -> Result<ContactState, SolverError> {
+    let num = spec.numerics;
+    let grid = spec.grid;
+    let len = grid.len();
+    let da = grid.cell_area();
+    let load = spec.load.normal_force_n;
+    let tol = num.tolerance;
+    let mut normal_iterations = normal0.report.iterations;
+    let mut normal_report = normal0.report;
+    let mut approach = normal0.approach;
+    let mut p = normal0.p;
+    drop(normal0.uz);
+    let force = spec.load.tangential_force();
+    let fnorm = force[0].hypot(force[1]);
+
+    let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
+    let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
+    let mut stick: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
+    let mut shift = [0.0; 2];
+    let mut tangential_iterations = 0;
+    let mut tan_report = TangentialReport {
+        converged: true,
+        ..Default::default()
+    };
+    let mut coupling_iterations = 0;
+    let mut coupling_change = 0.0;
+    let mut coupling_converged = true;
+
+    if fnorm > 0.0 {
+        let (mut ex, mut ey) = (vec![0.0; len], vec![0.0; len]);
+        let mut hq = vec![0.0; len];
+        // The pressure before tangential loading: the coupling term is the
+        // tangential displacement of the pressure's change since then.
+        let p0 = if num.coupling { p.clone() } else { Vec::new() };
+        coupling_converged = !num.coupling;
+        let mut have_q = false;
+        // Inexact inner solves while the coupling loop is far from converged:
+        // each inner tolerance follows the last change of p, and the final
+        // passes use the configured tolerances.
+        let mut prev_change: f64 = 1e-2;
+        let mut anderson = Anderson::new(ANDERSON_DEPTH, len);
+        for k in 1..=num.max_coupling_iterations {
+            coupling_iterations = k;
+            let exact_pass = !num.coupling || prev_change < 10.0 * num.coupling_tolerance;
+            // In the final passes the tangential residual must not show as a
+            // change of p above the coupling tolerance: with the default
+            // coupling tolerance the KKT tolerance stays as configured; a
+            // tighter coupling tolerance tightens it (p moves by about 1e-2 of
+            // the tangential residual per pass).
+            let (tan_tol, normal_tol) = if exact_pass {
+                (
+                    num.tangential_tolerance
+                        .min(100.0 * num.coupling_tolerance)
+                        .max(1e-12),
+                    tol,
+                )
+            } else {
+                (
+                    num.tangential_tolerance.max(0.1 * prev_change),
+                    tol.max(1e-2 * prev_change),
+                )
+            };
+            if num.coupling {
+                // hq is free until uz(q) is computed below.
+                for ((d, a), b) in hq.iter_mut().zip(&p).zip(&p0) {
+                    *d = a - b;
+                }
+                res.operator
+                    .apply(&[(Z, &hq)], &mut [(X, &mut ex), (Y, &mut ey)]);
+            }
+            // The previous pass's slip is not an input: free it meanwhile.
+            drop((std::mem::take(&mut sx), std::mem::take(&mut sy)));
+            let sol = res.solve_tangential(&TangentialProblem {
+                p: &p,
+                friction: spec.load.friction,
+                force,
+                extra: num.coupling.then_some((&ex[..], &ey[..])),
+                tolerance: tan_tol,
+                max_iterations: num.max_iterations,
+                start: if have_q {
+                    TangentialStart::Tractions(&qx, &qy)
+                } else {
+                    TangentialStart::Proportional
+                },
+            })?;
+            have_q = true;
+            tangential_iterations += sol.report.iterations;
+            tan_report = sol.report;
+            qx = sol.qx;
+            qy = sol.qy;
+            sx = sol.sx;
+            sy = sol.sy;
+            stick = sol.stick;
+            shift = sol.shift;
+            if !num.coupling || coupling_converged {
+                break;
+            }
+            res.operator
+                .apply(&[(X, &qx), (Y, &qy)], &mut [(Z, &mut hq)]);
+            // Anderson mixing of the coupling gap uz(q) while the loop is far
+            // from converged; plain (Picard) passes at the end, so the
+            // convergence test below is the fixed-point test of the plain loop.
+            if exact_pass {
+                anderson.reset();
+            } else {
+                anderson.mix(&mut hq);
+            }
+            let nsol = res.solve_normal(&NormalProblem {
+                extra_gap: Some(&hq),
+                tolerance: normal_tol,
+                max_iterations: num.max_iterations,
+                p_init: Some(&p),
+                ..NormalProblem::new(h0, load)
+            })?;
+            normal_iterations += nsol.report.iterations;
+            normal_report = nsol.report;
+            coupling_change = p
+                .iter()
+                .zip(&nsol.p)
+                .map(|(a, b)| (a - b).abs())
+                .sum::<f64>()
+                * da
+                / load;
+            p = nsol.p;
+            approach = nsol.approach;
+            // One more tangential solve at the updated pressure closes the loop.
+            if coupling_change < num.coupling_tolerance && exact_pass {
+                coupling_converged = true;
+            }
+            prev_change = coupling_change;
+        }
+    }
+    Ok(ContactState {
+        p,
+        qx,
+        qy,
+        sx,
+        sy,
+        stick,
+        shift,
+        approach,
+        normal_report,
+        tangential_report: tan_report,
+        normal_iterations,
+        tangential_iterations,
+        coupling_iterations,
+        coupling_change,
+        coupling_converged,
+    })
+}
