@@ -3,14 +3,23 @@
 //! second run (or a second worker) does not pay an anisotropic kernel build
 //! again. Files live in `$MPCONTACT_CACHE_DIR`, else
 //! `$XDG_CACHE_HOME/mpcontact/kernels`, else `~/.cache/mpcontact/kernels`.
-//! A file that does not match its key exactly is ignored and rewritten.
+//!
+//! An entry is written to a private temporary file and renamed into place, so
+//! a reader never sees half a file. It ends with a CRC-32 of everything
+//! before it (header and data), verified on every load: a file that does not
+//! match its key, or whose checksum fails, is not used (the latter with a
+//! warning) and is rebuilt and rewritten. A directory that another user can
+//! write to (group- or world-writable, or owned by someone else) is refused:
+//! its kernels could be replaced under us.
 
 use num_complex::Complex64;
 use solver::{KernelKey, KernelStore, Spectra};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
-const MAGIC: &[u8; 8] = b"MPCKERN2";
+/// Format 3 adds the trailing checksum (format 2 files are rebuilt).
+const MAGIC: &[u8; 8] = b"MPCKERN3";
 
 /// Values read per chunk.
 const CHUNK: usize = 1 << 16;
@@ -18,12 +27,83 @@ const CHUNK: usize = 1 << 16;
 /// Kernel spectra as files in one directory.
 pub struct FileStore {
     dir: PathBuf,
+    /// Whether the directory may be used (checked once, on first use).
+    usable: OnceLock<bool>,
+}
+
+/// A reader that feeds everything it reads into a CRC-32.
+struct Crc<R> {
+    inner: R,
+    crc: crc32fast::Hasher,
+}
+
+impl<R: Read> Read for Crc<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.crc.update(&buf[..n]);
+        Ok(n)
+    }
+}
+
+/// A writer that feeds everything it writes into a CRC-32.
+struct CrcWriter<W> {
+    inner: W,
+    crc: crc32fast::Hasher,
+}
+
+impl<W: Write> Write for CrcWriter<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.crc.update(&buf[..n]);
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// What a read found.
+enum Entry {
+    /// A valid entry for the key.
+    Found(Spectra),
+    /// No entry for this key (another key, format or length).
+    Absent,
+    /// An entry for this key whose checksum or values are wrong.
+    Corrupt(&'static str),
+}
+
+/// Why `dir` must not hold our kernels, if it must not: writable by group or
+/// others, owned by another user, or not a directory.
+fn unsafe_dir(dir: &Path) -> Option<String> {
+    use std::os::unix::fs::MetadataExt;
+    let meta = std::fs::metadata(dir).ok()?;
+    if !meta.is_dir() {
+        return Some("it is not a directory".into());
+    }
+    let mode = meta.mode() & 0o7777;
+    if mode & 0o022 != 0 {
+        return Some(format!(
+            "it is writable by other users (mode {mode:o}); use a private directory (chmod go-w)"
+        ));
+    }
+    // SAFETY: geteuid has no preconditions and cannot fail.
+    let me = unsafe { libc::geteuid() };
+    if meta.uid() != me {
+        return Some(format!(
+            "it belongs to user id {}, not to this user ({me})",
+            meta.uid()
+        ));
+    }
+    None
 }
 
 impl FileStore {
-    /// A store in `dir` (created on first save).
+    /// A store in `dir` (created on first save, private to this user).
     pub fn new(dir: PathBuf) -> Self {
-        FileStore { dir }
+        FileStore {
+            dir,
+            usable: OnceLock::new(),
+        }
     }
 
     /// The default location (see the module docs); `None` when no home is known.
@@ -45,110 +125,189 @@ impl FileStore {
         }
     }
 
+    /// True when the directory exists (or was just created) private to this
+    /// user; otherwise warns once and the store is not used.
+    fn usable(&self) -> bool {
+        *self.usable.get_or_init(|| {
+            if !self.dir.exists() {
+                use std::os::unix::fs::DirBuilderExt;
+                if let Err(e) = std::fs::DirBuilder::new()
+                    .recursive(true)
+                    .mode(0o700)
+                    .create(&self.dir)
+                {
+                    eprintln!(
+                        "warning: kernel cache {} cannot be created ({e}); kernels are not stored",
+                        self.dir.display()
+                    );
+                    return false;
+                }
+            }
+            match unsafe_dir(&self.dir) {
+                Some(why) => {
+                    eprintln!(
+                        "warning: kernel cache {} is not used: {why}",
+                        self.dir.display()
+                    );
+                    false
+                }
+                None => true,
+            }
+        })
+    }
+
     fn path(&self, key: &KernelKey) -> PathBuf {
-        let key = key.as_str();
         // FNV-1a of the key names the file; the key itself is stored and checked.
         let mut h: u64 = 0xcbf29ce484222325;
-        for b in key.bytes() {
+        for b in key.as_str().bytes() {
             h ^= b as u64;
             h = h.wrapping_mul(0x100000001b3);
         }
         self.dir.join(format!("{h:016x}.kern"))
     }
 
-    fn read(path: &Path, key: &KernelKey, len: usize) -> std::io::Result<Option<Spectra>> {
+    fn read(path: &Path, key: &KernelKey, len: usize) -> std::io::Result<Entry> {
         let key = key.as_str();
-        let mut f = std::io::BufReader::new(std::fs::File::open(path)?);
+        let file = std::io::BufReader::new(std::fs::File::open(path)?);
+        let mut f = Crc {
+            inner: file,
+            crc: crc32fast::Hasher::new(),
+        };
         let mut magic = [0u8; 8];
         f.read_exact(&mut magic)?;
         let mut word = [0u8; 8];
         f.read_exact(&mut word)?;
         let klen = u64::from_le_bytes(word) as usize;
         if &magic != MAGIC || klen != key.len() {
-            return Ok(None);
+            return Ok(Entry::Absent);
         }
         let mut kbytes = vec![0u8; klen];
         f.read_exact(&mut kbytes)?;
         f.read_exact(&mut word)?;
         if kbytes != key.as_bytes() || u64::from_le_bytes(word) as usize != len {
-            return Ok(None);
+            return Ok(Entry::Absent);
         }
         let mut buf = vec![0u8; CHUNK * 8];
-        // Reads `out.len()` finite values, chunk by chunk (no whole-file buffer).
-        let mut read_values = |out: &mut [f64]| -> std::io::Result<bool> {
+        // Reads `out.len()` values, chunk by chunk (no whole-file buffer).
+        let mut read_values = |out: &mut [f64]| -> std::io::Result<()> {
             for part in out.chunks_mut(CHUNK) {
                 let bytes = &mut buf[..part.len() * 8];
                 f.read_exact(bytes)?;
                 for (v, c) in part.iter_mut().zip(bytes.chunks_exact(8)) {
                     *v = f64::from_le_bytes(c.try_into().expect("8 bytes"));
                 }
-                if part.iter().any(|v| !v.is_finite()) {
-                    return Ok(false);
-                }
             }
-            Ok(true)
+            Ok(())
         };
         let mut diag: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; len]);
         for d in diag.iter_mut() {
-            if !read_values(d)? {
-                return Ok(None);
-            }
+            read_values(d)?;
         }
         let mut off: [Vec<Complex64>; 3] = std::array::from_fn(|_| vec![Complex64::default(); len]);
         let mut pair = [0.0; 2 * 4096];
         for o in off.iter_mut() {
             for part in o.chunks_mut(4096) {
                 let vals = &mut pair[..2 * part.len()];
-                if !read_values(vals)? {
-                    return Ok(None);
-                }
+                read_values(vals)?;
                 for (z, v) in part.iter_mut().zip(vals.chunks_exact(2)) {
                     *z = Complex64::new(v[0], v[1]);
                 }
             }
         }
-        // Nothing may follow: a longer file is not this entry.
-        if f.read(&mut word)? != 0 {
-            return Ok(None);
+        let Crc {
+            inner: mut file,
+            crc,
+        } = f;
+        let mut stored = [0u8; 4];
+        if file.read_exact(&mut stored).is_err() {
+            return Ok(Entry::Corrupt("it is cut short"));
         }
-        Ok(Some(Spectra { diag, off }))
+        if u32::from_le_bytes(stored) != crc.finalize() {
+            return Ok(Entry::Corrupt("its checksum does not match its contents"));
+        }
+        // Nothing may follow: a longer file is not this entry.
+        if file.read(&mut word)? != 0 {
+            return Ok(Entry::Corrupt("it is longer than its entry"));
+        }
+        let finite = diag.iter().all(|d| d.iter().all(|v| v.is_finite()))
+            && off
+                .iter()
+                .all(|o| o.iter().all(|z| z.re.is_finite() && z.im.is_finite()));
+        if !finite {
+            return Ok(Entry::Corrupt("it holds non-finite values"));
+        }
+        Ok(Entry::Found(Spectra { diag, off }))
+    }
+
+    fn write(&self, key: &KernelKey, spectra: &Spectra) -> std::io::Result<()> {
+        let path = self.path(key);
+        let key = key.as_str();
+        // Write to a private temporary name, then rename: readers never see half a file.
+        let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+        let result = (|| {
+            let file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+            let mut f = CrcWriter {
+                inner: file,
+                crc: crc32fast::Hasher::new(),
+            };
+            f.write_all(MAGIC)?;
+            f.write_all(&(key.len() as u64).to_le_bytes())?;
+            f.write_all(key.as_bytes())?;
+            f.write_all(&(spectra.diag[0].len() as u64).to_le_bytes())?;
+            for d in &spectra.diag {
+                for v in d {
+                    f.write_all(&v.to_le_bytes())?;
+                }
+            }
+            for o in &spectra.off {
+                for z in o {
+                    f.write_all(&z.re.to_le_bytes())?;
+                    f.write_all(&z.im.to_le_bytes())?;
+                }
+            }
+            let CrcWriter { mut inner, crc } = f;
+            inner.write_all(&crc.finalize().to_le_bytes())?;
+            inner.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+            std::fs::rename(&tmp, &path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result
     }
 }
 
 impl KernelStore for FileStore {
     fn load(&self, key: &KernelKey, len: usize) -> Option<Spectra> {
-        Self::read(&self.path(key), key, len).ok().flatten()
+        if !self.usable() {
+            return None;
+        }
+        let path = self.path(key);
+        match Self::read(&path, key, len) {
+            Ok(Entry::Found(s)) => Some(s),
+            Ok(Entry::Corrupt(why)) => {
+                eprintln!(
+                    "warning: kernel cache entry {} is not used: {why}; rebuilding it",
+                    path.display()
+                );
+                None
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                eprintln!(
+                    "warning: kernel cache entry {} is not used: it is cut short; rebuilding it",
+                    path.display()
+                );
+                None
+            }
+            Ok(Entry::Absent) | Err(_) => None,
+        }
     }
 
     fn save(&self, key: &KernelKey, spectra: &Spectra) {
-        let write = || -> std::io::Result<()> {
-            std::fs::create_dir_all(&self.dir)?;
-            let path = self.path(key);
-            let key = key.as_str();
-            // Write to a private temporary name, then rename: readers never see half a file.
-            let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-            {
-                let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-                f.write_all(MAGIC)?;
-                f.write_all(&(key.len() as u64).to_le_bytes())?;
-                f.write_all(key.as_bytes())?;
-                f.write_all(&(spectra.diag[0].len() as u64).to_le_bytes())?;
-                for d in &spectra.diag {
-                    for v in d {
-                        f.write_all(&v.to_le_bytes())?;
-                    }
-                }
-                for o in &spectra.off {
-                    for z in o {
-                        f.write_all(&z.re.to_le_bytes())?;
-                        f.write_all(&z.im.to_le_bytes())?;
-                    }
-                }
-                f.flush()?;
-            }
-            std::fs::rename(&tmp, &path)
-        };
-        if let Err(e) = write() {
+        if !self.usable() {
+            return;
+        }
+        if let Err(e) = self.write(key, spectra) {
             eprintln!(
                 "warning: cannot store kernel in {}: {e}",
                 self.dir.display()
@@ -213,5 +372,78 @@ mod tests {
         assert_eq!(third.loads(), 0);
         assert_eq!(a.fields.p, c.fields.p);
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A store in a fresh private temporary directory (removed on drop).
+    fn private_store() -> (tempfile::TempDir, PathBuf) {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("kernels");
+        (tmp, dir)
+    }
+
+    fn cache_in(dir: &Path) -> solver::KernelCache {
+        solver::KernelCache::with_store(Box::new(FileStore::new(dir.to_path_buf())))
+    }
+
+    fn only_file(dir: &Path) -> PathBuf {
+        let files: Vec<PathBuf> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        assert_eq!(files.len(), 1, "{files:?}");
+        files[0].clone()
+    }
+
+    #[test]
+    fn issue20_item2_one_flipped_sign_bit_is_detected_and_the_kernel_rebuilt() {
+        let (_tmp, dir) = private_store();
+        let a = solve_case(&spec(), &mut cache_in(&dir)).unwrap();
+        let file = only_file(&dir);
+        let mut bytes = std::fs::read(&file).unwrap();
+        // The sign bit of one value in the middle of the data (little endian:
+        // the last byte of an 8-byte value).
+        let header = 8 + 8 + KernelKey::of(&spec()).as_str().len() + 8;
+        let k = header + (bytes.len() - header - 4) / 16 * 8 + 7;
+        bytes[k] ^= 0x80;
+        std::fs::write(&file, &bytes).unwrap();
+        let mut second = cache_in(&dir);
+        let b = solve_case(&spec(), &mut second).unwrap();
+        assert_eq!(second.loads(), 0, "the corrupt entry was not used");
+        assert_eq!(
+            a.fields.p, b.fields.p,
+            "the rebuilt kernel gives the same result"
+        );
+        // It was rewritten: a third cache loads it, and it verifies.
+        let mut third = cache_in(&dir);
+        let c = solve_case(&spec(), &mut third).unwrap();
+        assert_eq!(third.loads(), 1);
+        assert_eq!(a.fields.p, c.fields.p);
+    }
+
+    #[test]
+    fn issue20_item2_a_directory_writable_by_others_is_not_used() {
+        use std::os::unix::fs::PermissionsExt;
+        let (_tmp, dir) = private_store();
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o777)).unwrap();
+        let a = solve_case(&spec(), &mut cache_in(&dir)).unwrap();
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            0,
+            "nothing stored"
+        );
+        let mut second = cache_in(&dir);
+        let b = solve_case(&spec(), &mut second).unwrap();
+        assert_eq!(second.loads(), 0, "nothing loaded");
+        assert_eq!(a.fields.p, b.fields.p);
+        assert!(unsafe_dir(&dir)
+            .unwrap()
+            .contains("writable by other users"));
+        // A directory the store creates is private to its user.
+        let (_tmp2, fresh) = private_store();
+        let _ = solve_case(&spec(), &mut cache_in(&fresh)).unwrap();
+        let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o700);
+        assert!(unsafe_dir(&fresh).is_none());
     }
 }
