@@ -9,6 +9,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use coordinator::case::CaseKey;
+
 const EXE: &str = env!("CARGO_BIN_EXE_mpcontact");
 
 const CONFIG: &str = r#"
@@ -564,7 +566,7 @@ fn fake_request(
     client: &FakeClient,
     notifier: &iceoryx2::port::notifier::Notifier<iceoryx2::prelude::ipc::Service>,
     run: &str,
-    msg: protocol::ToCoord<worker::WireScalars>,
+    msg: protocol::ToCoord<CaseKey, worker::WireScalars>,
     extra: &[f64],
     version: Option<u32>,
 ) -> Option<String> {
@@ -586,7 +588,7 @@ fn fake_request(
     while t.elapsed().as_secs() < 3 {
         if let Some(r) = pending.receive().unwrap() {
             return Some(
-                match protocol::decode_to_worker::<worker::WireSpec>(r.payload(), run) {
+                match protocol::decode_to_worker::<CaseKey, worker::WireSpec>(r.payload(), run) {
                     Ok(d) => format!("{:?}", d.header.body),
                     Err(e) => format!("undecodable: {e}"),
                 },
@@ -628,10 +630,7 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
         let head: serde_json::Value =
             serde_json::from_str(journal.lines().next().unwrap()).unwrap();
         let run = head["run_id"].as_str().unwrap().to_string();
-        let done = journal_cases(&o)[0]["case_id"]
-            .as_str()
-            .unwrap()
-            .to_string();
+        let done: CaseKey = serde_json::from_value(journal_cases(&o)[0]["key"].clone()).unwrap();
 
         let mut cfg = protocol::ipc_config().unwrap();
         cfg.global.prefix = FileName::new(prefix("i").as_bytes()).unwrap();
@@ -654,9 +653,9 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
                 .notifier_builder()
                 .create()
                 .unwrap();
-        let result = |case: &str| {
+        let result = |case: &CaseKey| {
             protocol::ToCoord::Result(protocol::ResultHeader {
-                case_id: case.to_string(),
+                key: case.clone(),
                 worker_index: 77,
                 grid_n: 32,
                 solve_seconds: 0.1,
@@ -677,13 +676,14 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
             answer.contains("Rejected") && answer.contains("999"),
             "{answer}"
         );
-        fake_request(&client, &notifier, &run, result("Zz/flat/000.0"), &[], None);
+        let unknown = CaseKey::new("Zz", "flat", 0.0);
+        fake_request(&client, &notifier, &run, result(&unknown), &[], None);
         fake_request(&client, &notifier, &run, result(&done), &[], None);
         fake_request(
             &client,
             &notifier,
             &run,
-            result("Ni/circle-A/045.0"),
+            result(&CaseKey::new("Ni", "circle-A", 45.0)),
             &[1.0, 2.0, 3.0],
             None,
         );
