@@ -10,6 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use coordinator::case::CaseKey;
+// The worker's fault-injection hooks (cargo feature `fault-injection`, which
+// this crate's dev-dependency on the worker enables): hang or crash a worker
+// on a named case. This import fails to compile without them.
+use worker::fault_injection::{CRASH_CASE_ENV, HANG_CASE_ENV, HANG_MARKER_ENV};
 
 const EXE: &str = env!("CARGO_BIN_EXE_mpcontact");
 
@@ -412,8 +416,8 @@ fn hung_worker_is_killed_and_replaced_and_the_active_run_is_private() {
     let marker = dir.join("hang.marker");
     let hung_case = "Cu/flat/045.0";
     let mut cmd = sweep_cmd(&dir, "out", 2, "f");
-    cmd.env("MPCONTACT_TEST_HANG_CASE", hung_case)
-        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    cmd.env(HANG_CASE_ENV, hung_case)
+        .env(HANG_MARKER_ENV, &marker);
     let o = dir.join("out");
     let dir2 = dir.clone();
     let (status, lines) = run_timed(cmd, |_| {
@@ -481,7 +485,7 @@ fn case_that_crashes_its_worker_twice_is_marked_failed() {
     let dir = scratch("crash");
     let bad = "Ni/circle-A/000.0";
     let mut cmd = sweep_cmd(&dir, "out", 2, "g");
-    cmd.env("MPCONTACT_TEST_CRASH_CASE", bad);
+    cmd.env(CRASH_CASE_ENV, bad);
     let o = dir.join("out");
     let (status, lines) = run_timed(cmd, |_| {});
     let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
@@ -617,8 +621,8 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
     .unwrap();
     let marker = dir.join("hang.marker");
     let mut cmd = sweep_cmd(&dir, "out", 1, "i");
-    cmd.env("MPCONTACT_TEST_HANG_CASE", "Ni/circle-A/045.0")
-        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    cmd.env(HANG_CASE_ENV, "Ni/circle-A/045.0")
+        .env(HANG_MARKER_ENV, &marker);
     let o = dir.join("out");
     let (status, lines) = run_timed(cmd, |_| {
         let t = std::time::Instant::now();

@@ -128,7 +128,8 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
             }
             Some(ToWorker::Case(case)) => {
                 drop(pending);
-                test_hooks::before_solve(&case.key.to_string());
+                #[cfg(feature = "fault-injection")]
+                fault_injection::before_solve(&case.key.to_string());
                 let (msg, fields) = solve_one(&case, worker_index, &mut cache, &mut keys);
                 next = msg;
                 fields_buf = fields;
@@ -137,48 +138,8 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
     }
 }
 
-/// Fault injection for the end-to-end tests of the runner, read from the
-/// environment (inherited from the coordinator). **Test-only**: nothing in
-/// the product sets these variables, and unset they do nothing.
-///
-/// * `MPCONTACT_TEST_HANG_CASE=<case id>` with
-///   `MPCONTACT_TEST_HANG_MARKER=<path>`: the first worker to receive that
-///   case creates the marker file and then sleeps forever (alive, silent);
-///   a later worker finds the marker and solves the case normally.
-/// * `MPCONTACT_TEST_CRASH_CASE=<case id>`: every worker that receives that
-///   case aborts the process (SIGABRT).
-pub mod test_hooks {
-    /// Hang once on `MPCONTACT_TEST_HANG_CASE`.
-    pub const HANG_CASE_ENV: &str = "MPCONTACT_TEST_HANG_CASE";
-    /// Marker file making the hang happen once.
-    pub const HANG_MARKER_ENV: &str = "MPCONTACT_TEST_HANG_MARKER";
-    /// Abort on `MPCONTACT_TEST_CRASH_CASE`, every time.
-    pub const CRASH_CASE_ENV: &str = "MPCONTACT_TEST_CRASH_CASE";
-
-    /// Apply the hooks for `case_id` (no-op when the variables are unset).
-    pub fn before_solve(case_id: &str) {
-        if std::env::var(CRASH_CASE_ENV).is_ok_and(|c| c == case_id) {
-            eprintln!("test hook {CRASH_CASE_ENV}: aborting on {case_id}");
-            std::process::abort();
-        }
-        if std::env::var(HANG_CASE_ENV).is_ok_and(|c| c == case_id) {
-            let Some(marker) = std::env::var_os(HANG_MARKER_ENV) else {
-                return;
-            };
-            let first = std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&marker)
-                .is_ok();
-            if first {
-                eprintln!("test hook {HANG_CASE_ENV}: hanging on {case_id}");
-                loop {
-                    std::thread::sleep(std::time::Duration::from_secs(3600));
-                }
-            }
-        }
-    }
-}
+#[cfg(feature = "fault-injection")]
+pub mod fault_injection;
 
 fn solve_one<K: WireKey>(
     case: &CaseAssignment<K, WireSpec>,
