@@ -2,6 +2,8 @@
 //! cases. Unknown keys are errors naming the key (and the line, when it comes
 //! from the file). Units are in the key names; the cases carry SI.
 
+use crate::case::CaseKey;
+use crate::npy::read_npy_f64;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use solver::{
@@ -311,11 +313,6 @@ pub struct Config {
     pub base_dir: std::path::PathBuf,
 }
 
-/// A case's identity in a sweep: `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`.
-pub fn case_id(material: &str, surface: &str, angle_deg: f64) -> String {
-    format!("{material}/{surface}/{angle_deg:05.1}")
-}
-
 /// Applies one `KEY=VALUE` override to a TOML table. VALUE is read as TOML
 /// (`128`, `true`, `[1, 2]`, `"Cu"`); anything that is not TOML is a string.
 fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
@@ -540,13 +537,13 @@ impl Config {
     }
 
     /// All cases of the sweep in a fixed order: materials × surfaces × angles.
-    pub fn cases(&self) -> Result<Vec<(String, CaseSpec)>> {
+    pub fn cases(&self) -> Result<Vec<(CaseKey, CaseSpec)>> {
         let angles = self.sweep.angles_deg.values()?;
         let mut out = Vec::new();
         for m in &self.sweep.materials {
             for s in &self.sweep.surfaces {
                 for &a in &angles {
-                    out.push((case_id(m, s, a), self.spec(m, s, a)?));
+                    out.push((CaseKey::new(m, s, a), self.spec(m, s, a)?));
                 }
             }
         }
@@ -670,23 +667,6 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
     Ok(surface)
 }
 
-/// Reads a float64 (or float32) `.npy` file: shape and values in C order.
-fn read_npy_f64(path: &Path) -> Result<(Vec<u64>, Vec<f64>)> {
-    let bytes = std::fs::read(path)?;
-    let npy = npyz::NpyFile::new(&bytes[..])?;
-    let shape = npy.shape().to_vec();
-    if npy.order() != npyz::Order::C {
-        bail!("Fortran-ordered arrays are not supported; save with numpy's default C order");
-    }
-    let values: Vec<f64> = match npy.dtype() {
-        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 => {
-            npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
-        }
-        _ => npy.into_vec::<f64>()?,
-    };
-    Ok((shape, values))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -718,7 +698,12 @@ angles_deg = { start = 0, stop = 90, step = 45 }
     #[test]
     fn base_config_expands_to_three_cases_in_order() {
         let c = Config::parse(BASE, &[]).unwrap();
-        let ids: Vec<String> = c.cases().unwrap().into_iter().map(|(id, _)| id).collect();
+        let ids: Vec<String> = c
+            .cases()
+            .unwrap()
+            .into_iter()
+            .map(|(key, _)| key.to_string())
+            .collect();
         assert_eq!(ids, ["Fe/flat/000.0", "Fe/flat/045.0", "Fe/flat/090.0"]);
     }
 
@@ -815,8 +800,8 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         let heights: Vec<f64> = (0..64 * 64)
             .map(|i| if i % 7 == 0 { 0.5 } else { 0.0 })
             .collect();
-        crate::solve::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
-        crate::solve::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
+        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        crate::npy::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
         let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
             .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
         let c = Config::parse_in(&text, &[], &dir).unwrap();

@@ -3,8 +3,11 @@
 //! The `mpcontact` command line: config loading (`config`), single in-process
 //! solves (`solve`), the multi-process sweep runner over iceoryx2 (`run`), and
 //! the files they write. Physics lives in `solver`; messages in `protocol`.
+//! A case is named by one typed key (`case::CaseKey`) everywhere.
 
+pub mod case;
 pub mod config;
 pub mod maps;
+pub mod npy;
 pub mod run;
 pub mod solve;

@@ -222,9 +222,10 @@ fn real_main() -> Result<()> {
             print!("{}", materials_table());
             Ok(())
         }
-        Cmd::Worker { run, index } => {
-            worker::run_worker(&run, index.unwrap_or(1000 + std::process::id() as usize))
-        }
+        Cmd::Worker { run, index } => worker::run_worker::<coordinator::case::CaseKey>(
+            &run,
+            index.unwrap_or(1000 + std::process::id() as usize),
+        ),
     }
 }
 

@@ -1,36 +1,14 @@
 //! `mpcontact solve`: one case in-process (no IPC), for inspection — writes
-//! `case.json`, the fields as `.npy` and their PNG maps. Also the `.npy` writer shared with `run`.
+//! `case.json`, the fields as `.npy` (via `npy`) and their PNG maps. Touches
+//! no sweep state (plan, journal, workers).
 
+use crate::case::Status;
 use crate::config::Config;
+use crate::npy::write_fields;
 use anyhow::{anyhow, Context, Result};
-use npyz::WriterBuilder;
 use serde::Serialize;
-use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Fields};
-use std::io::BufWriter;
+use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Surface};
 use std::path::Path;
-
-/// Writes one `n x n` field as a 2-D float64 `.npy` (rows = y, columns = x).
-pub fn write_npy(path: &Path, n: usize, data: &[f64]) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = npyz::WriteOptions::new()
-        .default_dtype()
-        .shape(&[n as u64, n as u64])
-        .writer(BufWriter::new(file))
-        .begin_nd()?;
-    w.extend(data.iter().copied())?;
-    w.finish()?;
-    Ok(())
-}
-
-/// Writes every field of a case into `dir` as `<name>.npy`.
-pub fn write_fields(dir: &Path, fields: &Fields) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, data) in fields.named() {
-        write_npy(&dir.join(format!("{name}.npy")), fields.n, data)?;
-    }
-    Ok(())
-}
 
 /// What `case.json` holds.
 #[derive(Serialize)]
@@ -38,7 +16,7 @@ struct CaseJson<'a> {
     material: &'a str,
     surface: &'a str,
     angle_deg: f64,
-    status: &'static str,
+    status: Status,
     #[serde(flatten)]
     scalars: &'a CaseScalars,
     apparent_radius_definition: &'static str,
@@ -74,9 +52,10 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let out =
         solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
     let mut scalars = out.scalars;
-    // Anisotropic material: K_E from the flat twin (docs/physics-choices.md).
+    // Anisotropic material: K_E from the flat twin (docs/physics-choices.md,
+    // "Reported quantities").
     if spec.needs_flat_calibration() && scalars.mu_a.is_some() {
-        let flat = if spec.surface == spec.flat_twin().surface {
+        let flat = if spec.surface == Surface::Flat {
             scalars.clone()
         } else {
             solve_case(&spec.flat_twin(), &mut cache)
@@ -91,11 +70,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         material,
         surface,
         angle_deg: angle,
-        status: if scalars.converged {
-            "ok"
-        } else {
-            "not-converged"
-        },
+        status: Status::of_solved(scalars.converged),
         scalars: &scalars,
         apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
         grid_points: spec.grid.n,

@@ -9,6 +9,12 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use coordinator::case::CaseKey;
+// The worker's fault-injection hooks (cargo feature `fault-injection`, which
+// this crate's dev-dependency on the worker enables): hang or crash a worker
+// on a named case. This import fails to compile without them.
+use worker::fault_injection::{CRASH_CASE_ENV, HANG_CASE_ENV, HANG_MARKER_ENV};
+
 const EXE: &str = env!("CARGO_BIN_EXE_mpcontact");
 
 const CONFIG: &str = r#"
@@ -410,8 +416,8 @@ fn hung_worker_is_killed_and_replaced_and_the_active_run_is_private() {
     let marker = dir.join("hang.marker");
     let hung_case = "Cu/flat/045.0";
     let mut cmd = sweep_cmd(&dir, "out", 2, "f");
-    cmd.env("MPCONTACT_TEST_HANG_CASE", hung_case)
-        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    cmd.env(HANG_CASE_ENV, hung_case)
+        .env(HANG_MARKER_ENV, &marker);
     let o = dir.join("out");
     let dir2 = dir.clone();
     let (status, lines) = run_timed(cmd, |_| {
@@ -479,7 +485,7 @@ fn case_that_crashes_its_worker_twice_is_marked_failed() {
     let dir = scratch("crash");
     let bad = "Ni/circle-A/000.0";
     let mut cmd = sweep_cmd(&dir, "out", 2, "g");
-    cmd.env("MPCONTACT_TEST_CRASH_CASE", bad);
+    cmd.env(CRASH_CASE_ENV, bad);
     let o = dir.join("out");
     let (status, lines) = run_timed(cmd, |_| {});
     let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
@@ -564,7 +570,7 @@ fn fake_request(
     client: &FakeClient,
     notifier: &iceoryx2::port::notifier::Notifier<iceoryx2::prelude::ipc::Service>,
     run: &str,
-    msg: protocol::ToCoord<worker::WireScalars>,
+    msg: protocol::ToCoord<CaseKey, worker::WireScalars>,
     extra: &[f64],
     version: Option<u32>,
 ) -> Option<String> {
@@ -586,7 +592,7 @@ fn fake_request(
     while t.elapsed().as_secs() < 3 {
         if let Some(r) = pending.receive().unwrap() {
             return Some(
-                match protocol::decode_to_worker::<worker::WireSpec>(r.payload(), run) {
+                match protocol::decode_to_worker::<CaseKey, worker::WireSpec>(r.payload(), run) {
                     Ok(d) => format!("{:?}", d.header.body),
                     Err(e) => format!("undecodable: {e}"),
                 },
@@ -615,8 +621,8 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
     .unwrap();
     let marker = dir.join("hang.marker");
     let mut cmd = sweep_cmd(&dir, "out", 1, "i");
-    cmd.env("MPCONTACT_TEST_HANG_CASE", "Ni/circle-A/045.0")
-        .env("MPCONTACT_TEST_HANG_MARKER", &marker);
+    cmd.env(HANG_CASE_ENV, "Ni/circle-A/045.0")
+        .env(HANG_MARKER_ENV, &marker);
     let o = dir.join("out");
     let (status, lines) = run_timed(cmd, |_| {
         let t = std::time::Instant::now();
@@ -628,10 +634,7 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
         let head: serde_json::Value =
             serde_json::from_str(journal.lines().next().unwrap()).unwrap();
         let run = head["run_id"].as_str().unwrap().to_string();
-        let done = journal_cases(&o)[0]["case_id"]
-            .as_str()
-            .unwrap()
-            .to_string();
+        let done: CaseKey = serde_json::from_value(journal_cases(&o)[0]["key"].clone()).unwrap();
 
         let mut cfg = protocol::ipc_config().unwrap();
         cfg.global.prefix = FileName::new(prefix("i").as_bytes()).unwrap();
@@ -654,9 +657,9 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
                 .notifier_builder()
                 .create()
                 .unwrap();
-        let result = |case: &str| {
+        let result = |case: &CaseKey| {
             protocol::ToCoord::Result(protocol::ResultHeader {
-                case_id: case.to_string(),
+                key: case.clone(),
                 worker_index: 77,
                 grid_n: 32,
                 solve_seconds: 0.1,
@@ -677,13 +680,14 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
             answer.contains("Rejected") && answer.contains("999"),
             "{answer}"
         );
-        fake_request(&client, &notifier, &run, result("Zz/flat/000.0"), &[], None);
+        let unknown = CaseKey::new("Zz", "flat", 0.0);
+        fake_request(&client, &notifier, &run, result(&unknown), &[], None);
         fake_request(&client, &notifier, &run, result(&done), &[], None);
         fake_request(
             &client,
             &notifier,
             &run,
-            result("Ni/circle-A/045.0"),
+            result(&CaseKey::new("Ni", "circle-A", 45.0)),
             &[1.0, 2.0, 3.0],
             None,
         );

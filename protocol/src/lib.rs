@@ -3,8 +3,9 @@
 //! What the coordinator and its workers say to each other, and nothing else:
 //! the message types, the wire format, the protocol version, the service and
 //! node names of a run, and the one iceoryx2 [`Config`](iceoryx2::config::Config)
-//! every process of a run must share. No physics: case specifications and
-//! result scalars are carried as type parameters chosen by the caller.
+//! every process of a run must share. No physics: case keys, case
+//! specifications and result scalars are carried as type parameters chosen
+//! by the caller (`K`, `S`, `R`).
 //!
 //! ## Wire format
 //!
@@ -26,9 +27,9 @@
 //!
 //! ```
 //! use protocol::{decode_to_worker, encode_to_vec, ToWorker, Envelope};
-//! let msg: Envelope<ToWorker<String>> = Envelope::new("run1", ToWorker::Done);
+//! let msg: Envelope<ToWorker<String, String>> = Envelope::new("run1", ToWorker::Done);
 //! let bytes = encode_to_vec(&msg, &[]).unwrap();
-//! let back = decode_to_worker::<String>(&bytes, "run1").unwrap();
+//! let back = decode_to_worker::<String, String>(&bytes, "run1").unwrap();
 //! assert_eq!(back.header.body, ToWorker::Done);
 //! ```
 
@@ -52,7 +53,9 @@ pub use wire::{
 
 /// The version of this protocol. Bumped on every change of a message type or
 /// of the wire layout; a message carrying another version is rejected.
-pub const PROTOCOL_VERSION: u32 = 1;
+///
+/// 2: the case identity is a caller-chosen key type `K` (was a `case_id` string).
+pub const PROTOCOL_VERSION: u32 = 2;
 
 #[cfg(test)]
 mod tests;

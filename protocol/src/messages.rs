@@ -1,6 +1,8 @@
 //! The message types of a run. Owns their shapes only; encoding lives in
-//! `wire`, names and iceoryx2 settings in `ipc`. Case specifications (`S`) and
-//! result scalars (`R`) are chosen by the caller, so this crate knows no physics.
+//! `wire`, names and iceoryx2 settings in `ipc`. Case keys (`K`), case
+//! specifications (`S`) and result scalars (`R`) are chosen by the caller, so
+//! this crate knows no physics: a worker echoes the key it was given, and
+//! nothing here looks inside it.
 
 use serde::{Deserialize, Serialize};
 
@@ -36,13 +38,13 @@ impl<T> Envelope<T> {
 /// Worker → coordinator (requests of `<run>/work`). Each request also asks for
 /// the next piece of work: the coordinator answers with a [`ToWorker`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ToCoord<R> {
+pub enum ToCoord<K, R> {
     /// First message of a worker.
     Ready(Ready),
     /// A solved case; its field arrays (if any) follow the header.
-    Result(ResultHeader<R>),
+    Result(ResultHeader<K, R>),
     /// A case the solver refused or failed.
-    Failed(Failure),
+    Failed(Failure<K>),
     /// Liveness while idle or between cases (reserved; the coordinator
     /// answers with the next case like any other request).
     Heartbeat {
@@ -53,9 +55,9 @@ pub enum ToCoord<R> {
 
 /// Coordinator → worker (responses of `<run>/work`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ToWorker<S> {
+pub enum ToWorker<K, S> {
     /// Solve this case.
-    Case(CaseAssignment<S>),
+    Case(CaseAssignment<K, S>),
     /// The run is over: exit.
     Done,
     /// The request was rejected (wrong version, malformed, ...): exit.
@@ -76,9 +78,9 @@ pub struct Ready {
 
 /// One case to solve.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CaseAssignment<S> {
-    /// Case identity, e.g. `Cu/flat/015.0`.
-    pub case_id: String,
+pub struct CaseAssignment<K, S> {
+    /// Case identity, chosen by the coordinator; returned unchanged with the result.
+    pub key: K,
     /// Grid points per side; every returned field must hold `n * n` values.
     pub grid_n: u32,
     /// Return the field arrays with the result.
@@ -92,9 +94,9 @@ pub struct CaseAssignment<S> {
 /// The header of a solved case; `field_names.len()` arrays of
 /// `grid_n * grid_n` f64 follow it on the wire.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ResultHeader<R> {
-    /// Which case.
-    pub case_id: String,
+pub struct ResultHeader<K, R> {
+    /// Which case: the key of its [`CaseAssignment`].
+    pub key: K,
     /// Who solved it.
     pub worker_index: u32,
     /// Grid points per side of the fields.
@@ -116,9 +118,9 @@ pub struct ResultHeader<R> {
 
 /// A case the worker could not solve.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Failure {
-    /// Which case.
-    pub case_id: String,
+pub struct Failure<K> {
+    /// Which case: the key of its [`CaseAssignment`].
+    pub key: K,
     /// Who tried.
     pub worker_index: u32,
     /// The solver's error, rendered.

@@ -8,9 +8,9 @@ fn scalars() -> Scalars {
     vec![("mu_a".into(), 0.21), ("k_e".into(), 1.5e11)]
 }
 
-fn result_header(n: u32, fields: bool) -> ResultHeader<Scalars> {
+fn result_header(n: u32, fields: bool) -> ResultHeader<String, Scalars> {
     ResultHeader {
-        case_id: "Cu/flat/015.0".into(),
+        key: "Cu/flat/015.0".into(),
         worker_index: 1,
         grid_n: n,
         solve_seconds: 0.5,
@@ -36,20 +36,20 @@ fn arrays(n: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn encode_result(h: ResultHeader<Scalars>, fields: &[Vec<f64>]) -> Vec<u8> {
+fn encode_result(h: ResultHeader<String, Scalars>, fields: &[Vec<f64>]) -> Vec<u8> {
     let refs: Vec<&[f64]> = fields.iter().map(|f| f.as_slice()).collect();
     encode_to_vec(&Envelope::new("run1", ToCoord::Result(h)), &refs).unwrap()
 }
 
-fn expect_case(id: &str) -> Option<Expected> {
+fn expect_case(id: &String) -> Option<Expected> {
     (id == "Cu/flat/015.0").then_some(Expected {
         grid_n: 4,
         want_fields: true,
     })
 }
 
-fn decode_and_validate(bytes: &[u8]) -> Result<ResultHeader<Scalars>, ProtocolError> {
-    let d = decode_to_coord::<Scalars>(bytes, "run1")?;
+fn decode_and_validate(bytes: &[u8]) -> Result<ResultHeader<String, Scalars>, ProtocolError> {
+    let d = decode_to_coord::<String, Scalars>(bytes, "run1")?;
     match d.header.body {
         ToCoord::Result(h) => {
             validate_result(&h, d.field_bytes, expect_case)?;
@@ -67,7 +67,7 @@ fn result_round_trip_is_bit_exact_and_zero_copy_when_aligned() {
     fields[0][2] = f64::MAX;
     let bytes = encode_result(result_header(4, true), &fields);
     assert_eq!(&bytes[0..4], &MAGIC);
-    let d = decode_to_coord::<Scalars>(&bytes, "run1").unwrap();
+    let d = decode_to_coord::<String, Scalars>(&bytes, "run1").unwrap();
     let ToCoord::Result(h) = &d.header.body else {
         panic!("not a result")
     };
@@ -97,7 +97,7 @@ fn unaligned_payload_is_copied_not_misread() {
     let bytes = encode_result(result_header(4, true), &fields);
     let mut shifted = vec![0u8; bytes.len() + 1];
     shifted[1..].copy_from_slice(&bytes);
-    let d = decode_to_coord::<Scalars>(&shifted[1..], "run1").unwrap();
+    let d = decode_to_coord::<String, Scalars>(&shifted[1..], "run1").unwrap();
     assert_eq!(d.field(3, 16).unwrap().as_ref(), fields[3].as_slice());
 }
 
@@ -105,7 +105,7 @@ fn unaligned_payload_is_copied_not_misread() {
 fn array_region_starts_on_8_byte_boundary() {
     for extra in 0..16 {
         let mut h = result_header(2, false);
-        h.case_id = "x".repeat(extra + 1);
+        h.key = "x".repeat(extra + 1);
         let header = encode_header(&Envelope::new("r", ToCoord::Result(h))).unwrap();
         let len = frame_len(header.len(), 3);
         assert!((len - 24).is_multiple_of(8));
@@ -116,7 +116,7 @@ fn array_region_starts_on_8_byte_boundary() {
 #[test]
 fn coordinator_messages_round_trip() {
     let case = ToWorker::Case(CaseAssignment {
-        case_id: "Ni/circle-A/090.0".into(),
+        key: "Ni/circle-A/090.0".into(),
         grid_n: 64,
         want_fields: false,
         attempt: 1,
@@ -130,17 +130,17 @@ fn coordinator_messages_round_trip() {
         },
     ] {
         let bytes = encode_to_vec(&Envelope::new("r9", msg.clone()), &[]).unwrap();
-        let d = decode_to_worker::<String>(&bytes, "r9").unwrap();
+        let d = decode_to_worker::<String, String>(&bytes, "r9").unwrap();
         assert_eq!(d.header.body, msg);
         assert_eq!(d.header.version, PROTOCOL_VERSION);
     }
-    let ready = ToCoord::<Scalars>::Ready(Ready {
+    let ready = ToCoord::<String, Scalars>::Ready(Ready {
         worker_index: 3,
         pid: 77,
     });
     let bytes = encode_to_vec(&Envelope::new("r9", ready.clone()), &[]).unwrap();
     assert_eq!(
-        decode_to_coord::<Scalars>(&bytes, "r9")
+        decode_to_coord::<String, Scalars>(&bytes, "r9")
             .unwrap()
             .header
             .body,
@@ -152,15 +152,15 @@ fn coordinator_messages_round_trip() {
 fn rejects_truncated_prefix_and_header() {
     let bytes = encode_result(result_header(4, true), &arrays(4));
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes[..5], "run1"),
+        decode_to_coord::<String, Scalars>(&bytes[..5], "run1"),
         Err(ProtocolError::Truncated { .. })
     ));
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes[..20], "run1"),
+        decode_to_coord::<String, Scalars>(&bytes[..20], "run1"),
         Err(ProtocolError::Truncated { .. })
     ));
     assert!(matches!(
-        decode_to_coord::<Scalars>(&[], "run1"),
+        decode_to_coord::<String, Scalars>(&[], "run1"),
         Err(ProtocolError::Truncated { .. })
     ));
 }
@@ -170,7 +170,7 @@ fn rejects_bad_magic() {
     let mut bytes = encode_result(result_header(4, false), &[]);
     bytes[0] = b'X';
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes, "run1"),
+        decode_to_coord::<String, Scalars>(&bytes, "run1"),
         Err(ProtocolError::BadMagic(_))
     ));
 }
@@ -180,7 +180,7 @@ fn rejects_other_protocol_version() {
     let mut bytes = encode_result(result_header(4, false), &[]);
     bytes[4..8].copy_from_slice(&(PROTOCOL_VERSION + 1).to_le_bytes());
     assert_eq!(
-        decode_to_coord::<Scalars>(&bytes, "run1").unwrap_err(),
+        decode_to_coord::<String, Scalars>(&bytes, "run1").unwrap_err(),
         ProtocolError::Version {
             got: PROTOCOL_VERSION + 1,
             expected: PROTOCOL_VERSION
@@ -191,7 +191,7 @@ fn rejects_other_protocol_version() {
     env.version = 0;
     let bytes = encode_to_vec(&env, &[]).unwrap();
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes, "run1"),
+        decode_to_coord::<String, Scalars>(&bytes, "run1"),
         Err(ProtocolError::Version { got: 0, .. })
     ));
 }
@@ -200,7 +200,7 @@ fn rejects_other_protocol_version() {
 fn rejects_message_of_another_run() {
     let bytes = encode_result(result_header(4, false), &[]);
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes, "run2"),
+        decode_to_coord::<String, Scalars>(&bytes, "run2"),
         Err(ProtocolError::WrongRun { .. })
     ));
 }
@@ -212,19 +212,23 @@ fn rejects_malformed_header() {
         *b = 0xff;
     }
     assert!(matches!(
-        decode_to_coord::<Scalars>(&bytes, "run1"),
+        decode_to_coord::<String, Scalars>(&bytes, "run1"),
         Err(ProtocolError::Header(_))
     ));
     // A worker message is not a coordinator message.
     let bytes = encode_result(result_header(4, false), &[]);
-    assert!(decode_to_worker::<String>(&bytes, "run1").is_err());
+    assert!(decode_to_worker::<String, String>(&bytes, "run1").is_err());
 }
 
 #[test]
 fn rejects_trailing_bytes_after_coordinator_message() {
-    let bytes = encode_to_vec(&Envelope::new("r", ToWorker::<String>::Done), &[&[1.0]]).unwrap();
+    let bytes = encode_to_vec(
+        &Envelope::new("r", ToWorker::<String, String>::Done),
+        &[&[1.0]],
+    )
+    .unwrap();
     assert!(matches!(
-        decode_to_worker::<String>(&bytes, "r"),
+        decode_to_worker::<String, String>(&bytes, "r"),
         Err(ProtocolError::Header(_))
     ));
 }
@@ -232,7 +236,7 @@ fn rejects_trailing_bytes_after_coordinator_message() {
 #[test]
 fn rejects_case_without_grid() {
     let case = ToWorker::Case(CaseAssignment {
-        case_id: "a".into(),
+        key: "a".to_string(),
         grid_n: 0,
         want_fields: false,
         attempt: 0,
@@ -240,7 +244,7 @@ fn rejects_case_without_grid() {
     });
     let bytes = encode_to_vec(&Envelope::new("r", case), &[]).unwrap();
     assert!(matches!(
-        decode_to_worker::<String>(&bytes, "r"),
+        decode_to_worker::<String, String>(&bytes, "r"),
         Err(ProtocolError::Invalid { .. })
     ));
 }
@@ -248,7 +252,7 @@ fn rejects_case_without_grid() {
 #[test]
 fn rejects_result_for_unknown_case() {
     let mut h = result_header(4, true);
-    h.case_id = "Zz/flat/000.0".into();
+    h.key = "Zz/flat/000.0".into();
     let bytes = encode_result(h, &arrays(4));
     assert_eq!(
         decode_and_validate(&bytes).unwrap_err(),
@@ -365,13 +369,13 @@ fn corrupted_payloads_never_panic() {
         bytes[at] ^= (state >> 17) as u8 | 1;
         let cut = (state >> 7) as usize % (bytes.len() + 1);
         let _ = decode_and_validate(&bytes[..cut.max(at + 1).min(bytes.len())]);
-        let _ = decode_to_worker::<String>(&bytes, "run1");
+        let _ = decode_to_worker::<String, String>(&bytes, "run1");
     }
 }
 
 #[test]
 fn encode_into_checks_buffer_size() {
-    let header = encode_header(&Envelope::new("r", ToWorker::<String>::Done)).unwrap();
+    let header = encode_header(&Envelope::new("r", ToWorker::<String, String>::Done)).unwrap();
     let mut buf = vec![0u8; frame_len(header.len(), 0) + 8];
     assert!(matches!(
         encode_into(&mut buf, &header, &[]),

@@ -3,6 +3,7 @@
 //! every malformed payload is a [`ProtocolError`].
 
 use std::borrow::Cow;
+use std::fmt::Display;
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -58,7 +59,8 @@ pub enum ProtocolError {
         /// Our run id.
         expected: String,
     },
-    /// A result for a case this run does not know or did not dispatch.
+    /// A result for a case this run does not know or did not dispatch
+    /// (the key as displayed).
     #[error("result for unknown case {0:?}")]
     UnknownCase(String),
     /// Grid size in the result differs from the case's.
@@ -312,19 +314,19 @@ pub fn decode<'a, T: DeserializeOwned>(
 }
 
 /// Decode a worker → coordinator message.
-pub fn decode_to_coord<'a, R: DeserializeOwned>(
+pub fn decode_to_coord<'a, K: DeserializeOwned, R: DeserializeOwned>(
     payload: &'a [u8],
     run_id: &str,
-) -> Result<Decoded<'a, ToCoord<R>>, ProtocolError> {
+) -> Result<Decoded<'a, ToCoord<K, R>>, ProtocolError> {
     decode(payload, run_id)
 }
 
 /// Decode a coordinator → worker message (no arrays allowed).
-pub fn decode_to_worker<'a, S: DeserializeOwned>(
+pub fn decode_to_worker<'a, K: DeserializeOwned + Display, S: DeserializeOwned>(
     payload: &'a [u8],
     run_id: &str,
-) -> Result<Decoded<'a, ToWorker<S>>, ProtocolError> {
-    let d = decode(payload, run_id)?;
+) -> Result<Decoded<'a, ToWorker<K, S>>, ProtocolError> {
+    let d = decode::<ToWorker<K, S>>(payload, run_id)?;
     if !d.field_bytes.is_empty() {
         return Err(ProtocolError::Header(format!(
             "{} unexpected bytes after a coordinator message",
@@ -332,10 +334,10 @@ pub fn decode_to_worker<'a, S: DeserializeOwned>(
         )));
     }
     if let ToWorker::Case(c) = &d.header.body {
-        if c.case_id.is_empty() || c.grid_n == 0 {
+        if c.grid_n == 0 {
             return Err(ProtocolError::Invalid {
-                case_id: c.case_id.clone(),
-                what: format!("case id or grid size (n = {})", c.grid_n),
+                case_id: c.key.to_string(),
+                what: format!("grid size (n = {})", c.grid_n),
             });
         }
     }
@@ -353,14 +355,15 @@ pub struct Expected {
 
 /// Validate a decoded result against what was dispatched: known case, same
 /// grid, array region of exactly `fields * n²` values, known field names,
-/// finite scalars and timings. `expected` looks a case id up.
-pub fn validate_result<R: CheckFinite>(
-    header: &ResultHeader<R>,
+/// finite scalars and timings. `expected` looks a case key up; errors name
+/// the case by the key's `Display` text.
+pub fn validate_result<K: Display, R: CheckFinite>(
+    header: &ResultHeader<K, R>,
     field_bytes: &[u8],
-    expected: impl Fn(&str) -> Option<Expected>,
+    expected: impl Fn(&K) -> Option<Expected>,
 ) -> Result<(), ProtocolError> {
-    let case_id = &header.case_id;
-    let exp = expected(case_id).ok_or_else(|| ProtocolError::UnknownCase(case_id.clone()))?;
+    let case_id = &header.key.to_string();
+    let exp = expected(&header.key).ok_or_else(|| ProtocolError::UnknownCase(case_id.clone()))?;
     if header.grid_n != exp.grid_n {
         return Err(ProtocolError::Grid {
             case_id: case_id.clone(),

@@ -9,10 +9,14 @@
 //!
 //! It exits cleanly when the coordinator answers `Done`, and on its own when
 //! the coordinator's node disappears (checked on every timed-wait timeout).
+//!
+//! The case key is the coordinator's type (`K`): the worker returns it
+//! unchanged with the result and never looks inside it.
 
 pub mod kernel_store;
 
 use std::collections::HashSet;
+use std::fmt::{Debug, Display};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use anyhow::{anyhow, bail, Context};
@@ -25,6 +29,7 @@ use protocol::{
     CaseAssignment, CheckFinite, Envelope, Failure, Ready, ResultHeader, ToCoord, ToWorker,
     FIELD_NAMES,
 };
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use solver::{solve_case, CaseScalars, CaseSpec, KernelCache, KernelKey};
 
@@ -58,10 +63,15 @@ impl CheckFinite for WireScalars {
     }
 }
 
-/// Coordinator → worker message of this build.
-pub type CoordMessage = ToWorker<WireSpec>;
-/// Worker → coordinator message of this build.
-pub type WorkerMessage = ToCoord<WireScalars>;
+/// What a case key must be to travel: the worker only clones, displays (in
+/// logs and fault-injection hooks) and sends it back.
+pub trait WireKey: Clone + Debug + Display + Serialize + DeserializeOwned {}
+impl<K: Clone + Debug + Display + Serialize + DeserializeOwned> WireKey for K {}
+
+/// Coordinator → worker message of this build, for case keys `K`.
+pub type CoordMessage<K> = ToWorker<K, WireSpec>;
+/// Worker → coordinator message of this build, for case keys `K`.
+pub type WorkerMessage<K> = ToCoord<K, WireScalars>;
 
 /// How long a worker waits for the work service to appear at start.
 const ATTACH_TIMEOUT: Duration = Duration::from_secs(20);
@@ -83,26 +93,27 @@ struct Attached {
 }
 
 /// How a wait for the coordinator's answer ended.
-enum Answer {
-    Message(Box<CoordMessage>),
+enum Answer<K> {
+    Message(Box<CoordMessage<K>>),
     CoordinatorGone,
 }
 
 /// Attach to run `run_id` as worker `worker_index`, solve cases until the
 /// coordinator says `Done` (or disappears), then detach. Returns an error
-/// only when attaching fails or the coordinator rejects this worker.
-pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
+/// only when attaching fails or the coordinator rejects this worker. `K` is
+/// the coordinator's case key type.
+pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
     let w = attach(run_id, worker_index)?;
     let mut cache = kernel_store::FileStore::cache();
     let mut keys: HashSet<KernelKey> = HashSet::new();
-    let mut next: WorkerMessage = ToCoord::Ready(Ready {
+    let mut next: WorkerMessage<K> = ToCoord::Ready(Ready {
         worker_index: worker_index as u32,
         pid: std::process::id(),
     });
     let mut fields_buf: Option<solver::Fields> = None;
     loop {
         let pending = w.send(&next, fields_buf.as_ref())?;
-        let answer = match w.wait_answer(&pending)? {
+        let answer = match w.wait_answer::<K>(&pending)? {
             Answer::Message(m) => Some(*m),
             Answer::CoordinatorGone => None,
         };
@@ -117,7 +128,8 @@ pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
             }
             Some(ToWorker::Case(case)) => {
                 drop(pending);
-                test_hooks::before_solve(&case.case_id);
+                #[cfg(feature = "fault-injection")]
+                fault_injection::before_solve(&case.key.to_string());
                 let (msg, fields) = solve_one(&case, worker_index, &mut cache, &mut keys);
                 next = msg;
                 fields_buf = fields;
@@ -126,55 +138,15 @@ pub fn run_worker(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
     }
 }
 
-/// Fault injection for the end-to-end tests of the runner, read from the
-/// environment (inherited from the coordinator). **Test-only**: nothing in
-/// the product sets these variables, and unset they do nothing.
-///
-/// * `MPCONTACT_TEST_HANG_CASE=<case id>` with
-///   `MPCONTACT_TEST_HANG_MARKER=<path>`: the first worker to receive that
-///   case creates the marker file and then sleeps forever (alive, silent);
-///   a later worker finds the marker and solves the case normally.
-/// * `MPCONTACT_TEST_CRASH_CASE=<case id>`: every worker that receives that
-///   case aborts the process (SIGABRT).
-pub mod test_hooks {
-    /// Hang once on `MPCONTACT_TEST_HANG_CASE`.
-    pub const HANG_CASE_ENV: &str = "MPCONTACT_TEST_HANG_CASE";
-    /// Marker file making the hang happen once.
-    pub const HANG_MARKER_ENV: &str = "MPCONTACT_TEST_HANG_MARKER";
-    /// Abort on `MPCONTACT_TEST_CRASH_CASE`, every time.
-    pub const CRASH_CASE_ENV: &str = "MPCONTACT_TEST_CRASH_CASE";
+#[cfg(feature = "fault-injection")]
+pub mod fault_injection;
 
-    /// Apply the hooks for `case_id` (no-op when the variables are unset).
-    pub fn before_solve(case_id: &str) {
-        if std::env::var(CRASH_CASE_ENV).is_ok_and(|c| c == case_id) {
-            eprintln!("test hook {CRASH_CASE_ENV}: aborting on {case_id}");
-            std::process::abort();
-        }
-        if std::env::var(HANG_CASE_ENV).is_ok_and(|c| c == case_id) {
-            let Some(marker) = std::env::var_os(HANG_MARKER_ENV) else {
-                return;
-            };
-            let first = std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&marker)
-                .is_ok();
-            if first {
-                eprintln!("test hook {HANG_CASE_ENV}: hanging on {case_id}");
-                loop {
-                    std::thread::sleep(std::time::Duration::from_secs(3600));
-                }
-            }
-        }
-    }
-}
-
-fn solve_one(
-    case: &CaseAssignment<WireSpec>,
+fn solve_one<K: WireKey>(
+    case: &CaseAssignment<K, WireSpec>,
     worker_index: usize,
     cache: &mut KernelCache,
     keys: &mut HashSet<KernelKey>,
-) -> (WorkerMessage, Option<solver::Fields>) {
+) -> (WorkerMessage<K>, Option<solver::Fields>) {
     let start = Instant::now();
     keys.insert(KernelKey::of(&case.spec));
     let solved = solve_case(&case.spec, cache);
@@ -183,7 +155,7 @@ fn solve_one(
         Ok(out) => {
             let want = case.want_fields;
             let header = ResultHeader {
-                case_id: case.case_id.clone(),
+                key: case.key.clone(),
                 worker_index: worker_index as u32,
                 grid_n: case.grid_n,
                 solve_seconds,
@@ -201,7 +173,7 @@ fn solve_one(
         }
         Err(e) => (
             ToCoord::Failed(Failure {
-                case_id: case.case_id.clone(),
+                key: case.key.clone(),
                 worker_index: worker_index as u32,
                 error: e.to_string(),
                 solve_seconds,
@@ -266,9 +238,9 @@ fn attach(run_id: &str, index: usize) -> anyhow::Result<Attached> {
 impl Attached {
     /// Encode `msg` (and `fields` after its header) straight into a loaned
     /// request, send it and wake the coordinator.
-    fn send(
+    fn send<K: WireKey>(
         &self,
-        msg: &WorkerMessage,
+        msg: &WorkerMessage<K>,
         fields: Option<&solver::Fields>,
     ) -> anyhow::Result<Pending> {
         let mut msg = msg.clone();
@@ -316,14 +288,14 @@ impl Attached {
 
     /// Wait for the coordinator's answer to `pending`, checking on every
     /// timeout that the coordinator is still there.
-    fn wait_answer(&self, pending: &Pending) -> anyhow::Result<Answer> {
+    fn wait_answer<K: WireKey>(&self, pending: &Pending) -> anyhow::Result<Answer<K>> {
         loop {
             if let Some(response) = pending
                 .receive()
                 .map_err(|e| anyhow!("cannot receive response: {e:?}"))?
             {
                 let decoded =
-                    protocol::decode_to_worker::<WireSpec>(response.payload(), &self.run_id)
+                    protocol::decode_to_worker::<K, WireSpec>(response.payload(), &self.run_id)
                         .context("malformed message from the coordinator")?;
                 return Ok(Answer::Message(Box::new(decoded.header.body)));
             }
@@ -378,9 +350,9 @@ mod tests {
         }
     }
 
-    fn assignment(id: &str, spec: CaseSpec, want_fields: bool) -> CaseAssignment<WireSpec> {
+    fn assignment(id: &str, spec: CaseSpec, want_fields: bool) -> CaseAssignment<String, WireSpec> {
         CaseAssignment {
-            case_id: id.into(),
+            key: id.into(),
             grid_n: spec.grid.n as u32,
             want_fields,
             attempt: 0,
@@ -436,7 +408,7 @@ mod tests {
         let arrays: Vec<&[f64]> = f.named().iter().map(|(_, v)| v.as_slice()).collect();
         let bytes =
             protocol::encode_to_vec(&Envelope::new("r", ToCoord::Result(h)), &arrays).unwrap();
-        let d = protocol::decode_to_coord::<WireScalars>(&bytes, "r").unwrap();
+        let d = protocol::decode_to_coord::<String, WireScalars>(&bytes, "r").unwrap();
         let ToCoord::Result(h) = &d.header.body else {
             panic!("not a result")
         };

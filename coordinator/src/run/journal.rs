@@ -1,7 +1,8 @@
 //! `journal.jsonl`: the append-only record of finished cases that `--resume`
 //! reads. One JSON object per line; the first line is the header with the
 //! config echo. Every record is flushed and synced before the coordinator
-//! acknowledges the result. Owns only this file.
+//! acknowledges the result. Owns only this file and its line format; which
+//! case a line belongs to is decided by `record`, not here.
 
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufReader, Write};
@@ -11,16 +12,16 @@ use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
 use solver::CaseScalars;
 
+use crate::case::{CaseKey, Status};
+
 /// File name inside the output directory.
 pub const JOURNAL_FILE: &str = "journal.jsonl";
 
-/// One finished case.
+/// How one case ended: everything the journal keeps about it besides its key.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Record {
-    /// Case identity.
-    pub case_id: String,
+pub struct Outcome {
     /// `ok`, `not_converged` or `failed`.
-    pub status: String,
+    pub status: Status,
     /// Why it failed (status `failed`).
     pub error: Option<String>,
     /// Worker that produced it.
@@ -31,6 +32,45 @@ pub struct Record {
     pub kernel_builds: u64,
     /// Scalars as computed by the worker (μa before K_E calibration).
     pub scalars: Option<CaseScalars>,
+}
+
+impl Outcome {
+    /// A failure without scalars.
+    pub fn failed(error: String, worker: usize, seconds: f64, kernel_builds: u64) -> Self {
+        Outcome {
+            status: Status::Failed,
+            error: Some(error),
+            worker: worker as u32,
+            seconds,
+            kernel_builds,
+            scalars: None,
+        }
+    }
+}
+
+/// One finished case as a journal line.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Entry {
+    /// The key's display text (`Cu/flat/015.0`), for people reading the
+    /// file; the only identity in journals written before typed keys.
+    pub case_id: String,
+    /// The case (absent in journals of older builds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub key: Option<CaseKey>,
+    /// How it ended.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+}
+
+impl Entry {
+    /// The line of `key` with `outcome`.
+    pub fn new(key: &CaseKey, outcome: Outcome) -> Self {
+        Entry {
+            case_id: key.to_string(),
+            key: Some(key.clone()),
+            outcome,
+        }
+    }
 }
 
 /// A journal line.
@@ -47,7 +87,7 @@ pub enum Line {
         protocol_version: u32,
     },
     /// A finished case.
-    Case(Box<Record>),
+    Case(Box<Entry>),
 }
 
 /// The open journal.
@@ -61,8 +101,8 @@ pub struct Journal {
 pub struct Previous {
     /// Run id of the first run.
     pub run_id: Option<String>,
-    /// Records in order (the last one wins for a repeated id).
-    pub records: Vec<Record>,
+    /// Case lines in order (the last one wins for a repeated case).
+    pub entries: Vec<Entry>,
     /// A torn last line was dropped.
     pub torn_tail: bool,
 }
@@ -129,7 +169,7 @@ impl Journal {
                         }
                         prev.run_id = Some(old);
                     }
-                    Some(Line::Case(r)) if !first => prev.records.push(*r),
+                    Some(Line::Case(r)) if !first => prev.entries.push(*r),
                     _ if last => {
                         prev.torn_tail = true;
                         break;
@@ -185,8 +225,8 @@ impl Journal {
             .with_context(|| format!("while appending to {}", self.path.display()))
     }
 
-    /// Read all case records of a journal file (tests, tools).
-    pub fn read_records(path: &Path) -> anyhow::Result<Vec<Record>> {
+    /// Read all case lines of a journal file (tests, tools).
+    pub fn read_entries(path: &Path) -> anyhow::Result<Vec<Entry>> {
         let f = File::open(path)?;
         let mut out = Vec::new();
         for line in BufReader::new(f).lines() {
@@ -209,16 +249,18 @@ mod tests {
         d
     }
 
-    fn rec(id: &str) -> Record {
-        Record {
-            case_id: id.into(),
-            status: "ok".into(),
-            error: None,
-            worker: 0,
-            seconds: 0.1,
-            kernel_builds: 1,
-            scalars: Some(CaseScalars::default()),
-        }
+    fn rec(id: &str) -> Entry {
+        Entry::new(
+            &CaseKey::new(id, "flat", 15.0),
+            Outcome {
+                status: Status::Ok,
+                error: None,
+                worker: 0,
+                seconds: 0.1,
+                kernel_builds: 1,
+                scalars: Some(CaseScalars::default()),
+            },
+        )
     }
 
     #[test]
@@ -226,7 +268,7 @@ mod tests {
         let d = tmp("torn");
         {
             let (mut j, prev) = Journal::open(&d, "r1", "cfg", false).unwrap();
-            assert!(prev.records.is_empty());
+            assert!(prev.entries.is_empty());
             j.append(&Line::Case(Box::new(rec("a")))).unwrap();
             j.append(&Line::Case(Box::new(rec("b")))).unwrap();
         }
@@ -240,9 +282,33 @@ mod tests {
         );
         let (mut j, prev) = Journal::open(&d, "r2", "cfg", true).unwrap();
         assert!(prev.torn_tail);
-        assert_eq!(prev.records.len(), 2);
+        assert_eq!(prev.entries.len(), 2);
+        assert_eq!(prev.entries[1], rec("b"));
         j.append(&Line::Case(Box::new(rec("c")))).unwrap();
-        assert_eq!(Journal::read_records(&p).unwrap().len(), 3);
+        assert_eq!(Journal::read_entries(&p).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn new_lines_carry_the_typed_key_and_the_display_text() {
+        let text = serde_json::to_string(&Line::Case(Box::new(rec("Cu")))).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["case_id"], "Cu/flat/015.0");
+        assert_eq!(v["key"]["material"], "Cu");
+        assert_eq!(v["key"]["surface"], "flat");
+        assert_eq!(v["key"]["angle_deg"], 15.0);
+        assert_eq!(v["status"], "ok");
+    }
+
+    #[test]
+    fn lines_of_older_builds_still_read() {
+        let old = r#"{"kind":"case","case_id":"Cu/flat/015.0","status":"not-converged","error":null,"worker":1,"seconds":0.5,"kernel_builds":1,"scalars":null}"#;
+        let Line::Case(e) = serde_json::from_str::<Line>(old).unwrap() else {
+            panic!("not a case line")
+        };
+        assert_eq!(e.case_id, "Cu/flat/015.0");
+        assert_eq!(e.key, None);
+        assert_eq!(e.outcome.status, Status::NotConverged);
+        assert_eq!(e.outcome.worker, 1);
     }
 
     #[test]

@@ -2,27 +2,34 @@
 //! serves the `<run>/work` pull queue to spawned (or hand-started) workers,
 //! detects dead workers and requeues their cases, journals every result
 //! before acknowledging it, and writes the outputs. Physics stays in
-//! `solver`, message shapes in `protocol`; this module wires them together.
+//! `solver`, message shapes in `protocol`; this module only drives:
 //!
-//! Flow: [`run_sweep`] → plan + journal (resume) → [`server::Session`] loop
-//! (WaitSet on the to-coord event + a liveness interval) → outputs.
+//! [`run_sweep`]: lock the output directory (`lock`) → plan the cases
+//! (`plan`) → open the record (`record`, resuming the journal) → start
+//! workers (`supervise`) and serve them (`dispatch` over `exchange`) until
+//! every case is recorded → write the outputs (`output`, `summary`).
 
+mod dispatch;
+mod exchange;
 mod journal;
+mod lock;
 mod output;
 mod plan;
 mod progress;
-mod server;
+mod record;
+mod summary;
+mod supervise;
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::time::{Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
 use serde::Serialize;
 
-pub use journal::{Journal, Line, Record, JOURNAL_FILE};
+pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use output::{fmt_f64, CURVES_HEADER, RESULTS_HEADER};
 pub use plan::{CaseState, Plan, PlannedCase};
+pub use summary::{IpcStats, RunSummary, WorkerSummary};
 
 use crate::config::Config;
 
@@ -45,81 +52,6 @@ pub struct RunArgs {
     pub exe: PathBuf,
 }
 
-/// Per-worker statistics in `summary.json`.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct WorkerSummary {
-    /// Cases this worker recorded.
-    pub cases: u64,
-    /// Kernels (operators) it built — once per (material, grid) it saw.
-    pub kernel_builds: u64,
-    /// It died (or was lost) during the run.
-    pub died: bool,
-}
-
-/// IPC cost of results by grid size (clocks of one machine).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct IpcStats {
-    /// Grid points per side.
-    pub grid_n: u32,
-    /// Results measured.
-    pub count: usize,
-    /// Median from "result ready" in the worker to "recorded" (fields
-    /// written, journal synced) in the coordinator, ms.
-    pub median_ms: f64,
-    /// Maximum of the same, ms.
-    pub max_ms: f64,
-    /// Median from "result ready" to "request received" by the coordinator
-    /// (the shared-memory transfer and wake-up alone), ms.
-    pub median_transfer_ms: f64,
-    /// Bytes of one result payload (with fields when requested).
-    pub payload_bytes: usize,
-}
-
-/// What a sweep did; also written to `summary.json` (with the config echo).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RunSummary {
-    /// Run id (service and node names).
-    pub run_id: String,
-    /// Output directory.
-    pub out_dir: PathBuf,
-    /// Cases in the sweep.
-    pub total: usize,
-    /// Recorded with status `ok`.
-    pub ok: usize,
-    /// Recorded but not converged (excluded from curves).
-    pub not_converged: usize,
-    /// Failed cases (excluded from curves).
-    pub failed: usize,
-    /// Cases taken from the journal of an earlier run (`--resume`).
-    pub resumed: usize,
-    /// Failures: case id → reason.
-    pub failures: BTreeMap<String, String>,
-    /// Ids of non-converged cases.
-    pub not_converged_cases: Vec<String>,
-    /// Workers requested.
-    pub workers: usize,
-    /// Statistics by worker index.
-    pub per_worker: BTreeMap<String, WorkerSummary>,
-    /// Kernel builds by worker index (same numbers as `per_worker`).
-    pub kernel_builds: BTreeMap<String, u64>,
-    /// Wall time of the sweep, s.
-    pub wall_seconds: f64,
-    /// Cases solved in this invocation per minute of wall time.
-    pub cases_per_minute: f64,
-    /// Start, s since the Unix epoch.
-    pub started_unix_s: f64,
-    /// IPC cost of results by grid size.
-    pub ipc: Vec<IpcStats>,
-    /// Messages rejected by validation (logged).
-    pub rejected_messages: usize,
-    /// Output files that could not be written (plots need fonts).
-    pub output_warnings: Vec<String>,
-    /// Definition of the apparent radii a, c used in μa.
-    pub apparent_radius_definition: &'static str,
-    /// How K_E is obtained.
-    pub k_e_definition: &'static str,
-}
-
 fn new_run_id() -> String {
     let nanos = SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -132,47 +64,6 @@ fn new_run_id() -> String {
     )
 }
 
-/// An exclusive claim on an output directory for the life of a run.
-struct DirLock(PathBuf);
-
-impl DirLock {
-    fn take(out_dir: &std::path::Path) -> anyhow::Result<DirLock> {
-        let path = out_dir.join(".mpcontact.lock");
-        for _ in 0..2 {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&path)
-            {
-                Ok(mut f) => {
-                    use std::io::Write;
-                    writeln!(f, "{}", std::process::id())?;
-                    return Ok(DirLock(path));
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let pid = std::fs::read_to_string(&path).unwrap_or_default();
-                    let pid = pid.trim();
-                    if !pid.is_empty() && std::path::Path::new(&format!("/proc/{pid}")).exists() {
-                        anyhow::bail!(
-                            "{} is in use by a running sweep (pid {pid})",
-                            out_dir.display()
-                        );
-                    }
-                    let _ = std::fs::remove_file(&path);
-                }
-                Err(e) => return Err(e).context(format!("while locking {}", out_dir.display())),
-            }
-        }
-        anyhow::bail!("cannot lock {}", out_dir.display())
-    }
-}
-
-impl Drop for DirLock {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
-
 /// Run a sweep to the end and write its outputs; see the module docs.
 pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let started = Instant::now();
@@ -182,31 +73,24 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .unwrap_or(0.0);
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("while creating {}", args.out_dir.display()))?;
-    let _lock = DirLock::take(&args.out_dir)?;
+    let _lock = lock::DirLock::take(&args.out_dir)?;
     let run_id = new_run_id();
-    let save_fields = args.save_fields || args.config.output.save_fields;
-    let mut plan = Plan::new(args.config.cases()?);
+    let plan = Plan::new(args.config.cases()?);
     anyhow::ensure!(!plan.cases.is_empty(), "the sweep has no cases");
     let raw = args.config.to_toml();
-    let (mut journal, previous) = Journal::open(&args.out_dir, &run_id, &raw, args.resume)?;
-    let mut records: BTreeMap<String, Record> = BTreeMap::new();
-    for r in previous.records {
-        if let Some(i) = plan.index_of(&r.case_id) {
-            plan.cases[i].state = CaseState::Done;
-            records.insert(r.case_id.clone(), r);
-        }
-    }
-    let resumed = records.len();
-    let progress = progress::Progress::new(args.quiet, plan.cases.len(), resumed);
-    if previous.torn_tail {
+    let (mut recorder, resumed) =
+        record::Recorder::open(plan, &args.out_dir, &run_id, &raw, args.resume)?;
+    let total = recorder.plan().cases.len();
+    let progress = progress::Progress::new(args.quiet, total, resumed.cases);
+    if resumed.torn_tail {
         progress.note("journal: dropped a torn last line");
     }
 
     let mut summary = RunSummary {
         run_id: run_id.clone(),
         out_dir: args.out_dir.clone(),
-        total: plan.cases.len(),
-        resumed,
+        total,
+        resumed: resumed.cases,
         workers: args.workers,
         started_unix_s,
         apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
@@ -214,18 +98,28 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         ..Default::default()
     };
 
-    if plan.remaining() > 0 {
-        let mut session = server::Session::start(server::SessionArgs {
+    let remaining = recorder.plan().remaining();
+    if remaining > 0 {
+        let workers = args.workers.max(1).min(remaining);
+        let exchange = exchange::Exchange::open(&run_id, workers)?;
+        let mut supervisor = supervise::Supervisor::new(supervise::SuperviseArgs {
             run_id: &run_id,
-            workers: args.workers.max(1).min(plan.remaining()),
             exe: &args.exe,
             out_dir: &args.out_dir,
-            save_fields,
+            workers,
+            case_timeout: Duration::from_secs_f64(args.config.run.case_timeout_s),
+        });
+        let mut dispatch = dispatch::Dispatch::new(dispatch::DispatchArgs {
+            out_dir: &args.out_dir,
+            save_fields: args.save_fields || args.config.output.save_fields,
             progress: &progress,
-            case_timeout: std::time::Duration::from_secs_f64(args.config.run.case_timeout_s),
-        })?;
-        let outcome = session.serve(&mut plan, &mut journal, &mut records);
-        let stats = session.shutdown();
+        });
+        let outcome = (0..workers)
+            .try_for_each(|_| dispatch.spawn(&mut supervisor))
+            .and_then(|()| dispatch.serve(&exchange, &mut supervisor, &mut recorder));
+        let stats = dispatch.finish(&exchange);
+        supervisor.stop_all();
+        exchange.cleanup_dead_nodes();
         summary.per_worker = stats.per_worker;
         summary.ipc = stats.ipc;
         summary.rejected_messages = stats.rejected;
@@ -238,27 +132,13 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .iter()
         .map(|(k, w)| (k.clone(), w.kernel_builds))
         .collect();
-    for r in records.values() {
-        match r.status.as_str() {
-            "ok" => summary.ok += 1,
-            "not_converged" => {
-                summary.not_converged += 1;
-                summary.not_converged_cases.push(r.case_id.clone());
-            }
-            _ => {
-                summary.failed += 1;
-                summary.failures.insert(
-                    r.case_id.clone(),
-                    r.error.clone().unwrap_or_else(|| r.status.clone()),
-                );
-            }
-        }
-    }
+    let (cases, outcomes) = recorder.results();
+    summary.tally(cases, outcomes);
     summary.wall_seconds = started.elapsed().as_secs_f64();
-    let solved_now = records.len() - resumed;
+    let solved_now = recorder.recorded() - resumed.cases;
     summary.cases_per_minute = solved_now as f64 / (summary.wall_seconds / 60.0).max(1e-9);
 
-    write_outputs(args, &plan, &records, &mut summary, &raw)?;
+    write_outputs(args, &recorder, &mut summary, &raw)?;
     if !args.quiet {
         eprintln!(
             "{} cases: {} ok, {} not converged, {} failed ({} resumed) in {:.1} s → {}",
@@ -279,13 +159,13 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
 
 fn write_outputs(
     args: &RunArgs,
-    plan: &Plan,
-    records: &BTreeMap<String, Record>,
+    recorder: &record::Recorder,
     summary: &mut RunSummary,
     raw_config: &str,
 ) -> anyhow::Result<()> {
     let dir = &args.out_dir;
-    let rows = output::calibrate(&plan.cases, records);
+    let (cases, outcomes) = recorder.results();
+    let rows = output::calibrate(cases, outcomes);
     let write = |name: &str, text: String| {
         let p = dir.join(name);
         std::fs::write(&p, text).with_context(|| format!("while writing {}", p.display()))

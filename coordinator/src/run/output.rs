@@ -1,8 +1,8 @@
 //! The files a sweep writes: `results.csv`, `curves.csv`, `mu_a_vs_angle.{png,svg}`
-//! and `fields/<case>/*.npy`. Formatting is deterministic (rows sorted by case
-//! id, shortest round-trip floats) so that the CSVs do not depend on the
-//! number of workers. Owns no IPC and no physics beyond the K_E calibration
-//! call into the solver.
+//! and `fields/<case>/*.npy`. Formatting is deterministic (rows sorted by the
+//! case's display text, shortest round-trip floats) so that the CSVs do not
+//! depend on the number of workers. Owns no IPC, no journal and no physics
+//! beyond the K_E calibration call into the solver.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -11,10 +11,12 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use solver::{calibrate_on_flat, CaseScalars};
 
-use super::journal::Record;
+use super::journal::Outcome;
 use super::plan::PlannedCase;
+use crate::case::{CaseKey, Status};
 
-/// Header of `results.csv` (DESIGN.md).
+/// Header of `results.csv` (one row per case, see README.md). Users' tools
+/// read these names: change one only with a reason in the docs.
 pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker";
 /// Header of `curves.csv`.
 pub const CURVES_HEADER: &str = "material,surface,angle_deg,mu_a";
@@ -24,8 +26,8 @@ pub const CURVES_HEADER: &str = "material,surface,angle_deg,mu_a";
 pub struct Row<'a> {
     /// Plan entry.
     pub case: &'a PlannedCase,
-    /// Journal record.
-    pub record: &'a Record,
+    /// Its recorded outcome.
+    pub record: &'a Outcome,
     /// Scalars with the final μa and K_E.
     pub scalars: Option<CaseScalars>,
 }
@@ -40,29 +42,15 @@ pub fn fmt_f64(v: f64) -> String {
     }
 }
 
-/// Surface name of a case: the part of its id between material and angle.
-pub fn surface_name(case: &PlannedCase) -> String {
-    let rest = case
-        .id
-        .strip_prefix(&format!("{}/", case.spec.material.name))
-        .unwrap_or(&case.id);
-    match rest.rsplit_once('/') {
-        Some((s, _)) => s.to_string(),
-        None => rest.to_string(),
-    }
-}
-
 /// Apply the K_E calibration: patterned (and flat) cases of anisotropic
 /// materials get K_E(ψ) from the flat case of the same material, grid and
 /// angle, and μa recomputed with it. Cases without a flat twin keep the
 /// worker's isotropic-equivalent K_E.
-pub fn calibrate<'a>(
-    cases: &'a [PlannedCase],
-    records: &'a BTreeMap<String, Record>,
-) -> Vec<Row<'a>> {
+/// `records[i]` is the outcome of `cases[i]` (None: not recorded).
+pub fn calibrate<'a>(cases: &'a [PlannedCase], records: &'a [Option<Outcome>]) -> Vec<Row<'a>> {
     let mut rows = Vec::new();
-    for case in cases {
-        let Some(record) = records.get(&case.id) else {
+    for (case, record) in cases.iter().zip(records) {
+        let Some(record) = record else {
             continue;
         };
         let mut scalars = record.scalars.clone();
@@ -70,10 +58,10 @@ pub fn calibrate<'a>(
             let spec = &case.spec;
             if spec.needs_flat_calibration() {
                 let twin_spec = spec.flat_twin();
-                let twin = cases.iter().find(|c| c.spec == twin_spec);
+                let twin = cases.iter().position(|c| c.spec == twin_spec);
                 let flat = twin
-                    .and_then(|t| records.get(&t.id))
-                    .filter(|r| r.status != "failed")
+                    .and_then(|t| records.get(t).and_then(Option::as_ref))
+                    .filter(|r| r.status != Status::Failed)
                     .and_then(|r| r.scalars.as_ref());
                 if let Some(flat) = flat {
                     calibrate_on_flat(s, flat, &spec.load);
@@ -86,7 +74,8 @@ pub fn calibrate<'a>(
             scalars,
         });
     }
-    rows.sort_by(|a, b| a.case.id.cmp(&b.case.id));
+    // The order of the display text (as when cases were named by strings).
+    rows.sort_by_cached_key(|r| r.case.key.to_string());
     rows
 }
 
@@ -106,8 +95,8 @@ pub fn results_csv(rows: &[Row]) -> String {
         let _ = writeln!(
             out,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{}",
-            csv_field(&c.spec.material.name),
-            csv_field(&surface_name(c)),
+            csv_field(&c.key.material),
+            csv_field(&c.key.surface),
             fmt_f64(c.spec.load.angle_deg),
             r.record.status,
             opt(s.and_then(|s| s.mu_a)),
@@ -140,7 +129,7 @@ fn csv_field(s: &str) -> String {
 /// Rows that belong on a curve: solved, converged, with a μa.
 pub fn curve_points<'a>(rows: &'a [Row]) -> Vec<(&'a Row<'a>, f64)> {
     rows.iter()
-        .filter(|r| r.record.status == "ok")
+        .filter(|r| r.record.status == Status::Ok)
         .filter_map(|r| r.scalars.as_ref().and_then(|s| s.mu_a).map(|m| (r, m)))
         .collect()
 }
@@ -153,8 +142,8 @@ pub fn curves_csv(rows: &[Row]) -> String {
         let _ = writeln!(
             out,
             "{},{},{},{}",
-            csv_field(&r.case.spec.material.name),
-            csv_field(&surface_name(r.case)),
+            csv_field(&r.case.key.material),
+            csv_field(&r.case.key.surface),
             fmt_f64(r.case.spec.load.angle_deg),
             fmt_f64(mu)
         );
@@ -166,13 +155,9 @@ pub fn curves_csv(rows: &[Row]) -> String {
 pub fn curves(rows: &[Row]) -> BTreeMap<String, Vec<(f64, f64)>> {
     let mut m: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
     for (r, mu) in curve_points(rows) {
-        m.entry(format!(
-            "{} / {}",
-            r.case.spec.material.name,
-            surface_name(r.case)
-        ))
-        .or_default()
-        .push((r.case.spec.load.angle_deg, mu));
+        m.entry(format!("{} / {}", r.case.key.material, r.case.key.surface))
+            .or_default()
+            .push((r.case.spec.load.angle_deg, mu));
     }
     for v in m.values_mut() {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -253,11 +238,15 @@ pub fn plot_curves(path: &Path, curves: &BTreeMap<String, Vec<(f64, f64)>>) -> a
     .with_context(|| format!("while drawing {}", path.display()))
 }
 
-/// Directory of a case's fields: `fields/<material>/<surface>/<angle>`, each
-/// component of the case id made file-name safe.
-pub fn fields_dir(out_dir: &Path, case_id: &str) -> PathBuf {
+/// Directory of a case's fields: `fields/<material>/<surface>/<angle>`
+/// (`fields/Cu/flat/015.0`), each component made file-name safe.
+pub fn fields_dir(out_dir: &Path, key: &CaseKey) -> PathBuf {
     let mut p = out_dir.join("fields");
-    for part in case_id.split('/') {
+    for part in [
+        key.material.as_str(),
+        key.surface.as_str(),
+        &key.angle_text(),
+    ] {
         let safe: String = part
             .chars()
             .map(|c| {
@@ -277,6 +266,25 @@ pub fn fields_dir(out_dir: &Path, case_id: &str) -> PathBuf {
     p
 }
 
+/// Write the field arrays of a result (`names[k]` is array `k` of `n²`
+/// values in `field_bytes`) as `fields/<case>/<name>.npy`.
+pub fn write_result_fields(
+    out_dir: &Path,
+    key: &CaseKey,
+    n: usize,
+    names: &[String],
+    field_bytes: &[u8],
+) -> anyhow::Result<()> {
+    let dir = fields_dir(out_dir, key);
+    std::fs::create_dir_all(&dir).with_context(|| format!("while creating {}", dir.display()))?;
+    for (k, name) in names.iter().enumerate() {
+        let data = protocol::read_field(field_bytes, k, n * n)
+            .ok_or_else(|| anyhow::anyhow!("field {name} missing"))?;
+        crate::npy::write_npy(&dir.join(format!("{name}.npy")), n, &data)?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -292,7 +300,7 @@ mod tests {
         assert_eq!(fmt_f64(15.0), "15");
     }
 
-    fn aniso_case(id: &str, surface: Surface) -> PlannedCase {
+    fn aniso_case(surface_name: &str, surface: Surface) -> PlannedCase {
         let iso = solver::Isotropic::new(130e9, 0.34).unwrap();
         let mut c = iso.stiffness();
         c[(0, 0)] *= 1.2;
@@ -320,14 +328,14 @@ mod tests {
                 max_coupling_iterations: 5,
             },
         };
-        let mut plan = super::super::plan::Plan::new(vec![(id.to_string(), spec)]);
+        let key = CaseKey::new("Cu(111)", surface_name, 30.0);
+        let mut plan = super::super::plan::Plan::new(vec![(key, spec)]);
         plan.cases.remove(0)
     }
 
-    fn record(id: &str, a: f64, c: f64, dt: f64) -> Record {
-        Record {
-            case_id: id.into(),
-            status: "ok".into(),
+    fn record(a: f64, c: f64, dt: f64) -> Outcome {
+        Outcome {
+            status: Status::Ok,
             error: None,
             worker: 0,
             seconds: 1.0,
@@ -352,37 +360,36 @@ mod tests {
             offset: [0.0, 0.0],
             lattice: solver::LatticeKind::Square,
         };
-        let flat = aniso_case("Cu(111)/flat/030.0", Surface::Flat);
-        let pat = aniso_case("Cu(111)/circle-A/030.0", lattice);
+        let flat = aniso_case("flat", Surface::Flat);
+        let pat = aniso_case("circle-A", lattice);
         assert!(flat.calibration && !pat.calibration);
         let cases = vec![pat, flat];
-        let mut records = BTreeMap::new();
-        records.insert(
-            cases[1].id.clone(),
-            record(&cases[1].id, 2e-3, 1.5e-3, 3e-6),
-        );
-        records.insert(
-            cases[0].id.clone(),
-            record(&cases[0].id, 2.5e-3, 1.4e-3, 4e-6),
-        );
+        let records = vec![
+            Some(record(2.5e-3, 1.4e-3, 4e-6)),
+            Some(record(2e-3, 1.5e-3, 3e-6)),
+        ];
         let rows = calibrate(&cases, &records);
-        let flat_row = rows.iter().find(|r| r.case.id.contains("flat")).unwrap();
-        let pat_row = rows.iter().find(|r| r.case.id.contains("circle")).unwrap();
+        let flat_row = rows.iter().find(|r| r.case.key.surface == "flat").unwrap();
+        let pat_row = rows
+            .iter()
+            .find(|r| r.case.key.surface == "circle-A")
+            .unwrap();
         let fs = flat_row.scalars.as_ref().unwrap();
         // By construction Eq. 19 with the calibrated K_E returns μ on the flat case.
         assert!((fs.mu_a.unwrap() - 0.3).abs() < 1e-12, "{:?}", fs.mu_a);
-        let k_e = calibrate_k_e(records[&cases[1].id].scalars.as_ref().unwrap(), 0.3, 6000.0);
+        let outcome = |i: usize| records[i].as_ref().unwrap();
+        let k_e = calibrate_k_e(outcome(1).scalars.as_ref().unwrap(), 0.3, 6000.0);
         let ps = pat_row.scalars.as_ref().unwrap();
         assert_eq!(ps.k_e, k_e);
         assert_eq!(ps.k_e_source, "flat-calibrated");
-        let want = mu_apparent(records[&cases[0].id].scalars.as_ref().unwrap(), 6000.0, k_e);
+        let want = mu_apparent(outcome(0).scalars.as_ref().unwrap(), 6000.0, k_e);
         assert_eq!(ps.mu_a.unwrap(), want);
-        assert_eq!(surface_name(pat_row.case), "circle-A");
+        assert_eq!(pat_row.case.key.to_string(), "Cu(111)/circle-A/030.0");
     }
 
     #[test]
     fn fields_dir_is_safe() {
-        let d = fields_dir(Path::new("/o"), "Cu(111)/../045.0");
+        let d = fields_dir(Path::new("/o"), &CaseKey::new("Cu(111)", "..", 45.0));
         assert_eq!(d, Path::new("/o/fields/Cu(111)/_/045.0"));
     }
 }

@@ -1,9 +1,17 @@
-//! The cases of a sweep and who should solve which next. Owns dispatch order
-//! (K_E calibration cases first, material affinity); knows no IPC and no files.
+//! The cases of a sweep, each under its [`CaseKey`], and who should solve
+//! which next. Owns dispatch order (K_E calibration cases first, material
+//! affinity) and dispatch state; knows no IPC and no files. A case becomes
+//! `Done` only through `record::Recorder`, which owns the plan during a run.
+//!
+//! (A later check of the keys — no duplicates, no two angles closer than
+//! 0.1° — belongs in [`Plan::new`], the one place cases enter.)
 
 use std::collections::HashSet;
+use std::time::Instant;
 
 use solver::{CaseSpec, KernelKey, Surface};
+
+use crate::case::CaseKey;
 
 /// Where a case stands.
 #[derive(Clone, Debug, PartialEq)]
@@ -15,7 +23,7 @@ pub enum CaseState {
         /// Worker index.
         worker: usize,
         /// When it was dispatched.
-        since: std::time::Instant,
+        since: Instant,
     },
     /// Recorded (journalled); never dispatched again.
     Done,
@@ -24,8 +32,8 @@ pub enum CaseState {
 /// One case of the sweep.
 #[derive(Clone, Debug)]
 pub struct PlannedCase {
-    /// Case identity from the config, e.g. `Cu/flat/015.0`.
-    pub id: String,
+    /// Case identity from the config.
+    pub key: CaseKey,
     /// Its specification.
     pub spec: CaseSpec,
     /// The kernel it needs.
@@ -53,13 +61,13 @@ pub fn is_calibration(spec: &CaseSpec) -> bool {
 
 impl Plan {
     /// Plan the given cases (config order is kept for ties).
-    pub fn new(cases: Vec<(String, CaseSpec)>) -> Self {
+    pub fn new(cases: Vec<(CaseKey, CaseSpec)>) -> Self {
         let cases = cases
             .into_iter()
-            .map(|(id, spec)| PlannedCase {
+            .map(|(key, spec)| PlannedCase {
                 kernel_key: KernelKey::of(&spec),
                 calibration: is_calibration(&spec),
-                id,
+                key,
                 spec,
                 state: CaseState::Pending,
                 attempts: 0,
@@ -68,9 +76,55 @@ impl Plan {
         Plan { cases }
     }
 
-    /// Index of a case id.
-    pub fn index_of(&self, id: &str) -> Option<usize> {
-        self.cases.iter().position(|c| c.id == id)
+    /// Index of a case.
+    pub fn index_of(&self, key: &CaseKey) -> Option<usize> {
+        self.cases.iter().position(|c| c.key == *key)
+    }
+
+    /// Index of the case whose key displays as `text` (string equality, for
+    /// journals written before keys were typed; nothing is parsed).
+    pub fn index_of_display(&self, text: &str) -> Option<usize> {
+        self.cases.iter().position(|c| c.key.to_string() == text)
+    }
+
+    /// Case `i` was sent to `worker`: in flight from now, one more attempt.
+    pub fn dispatched(&mut self, i: usize, worker: usize) {
+        let case = &mut self.cases[i];
+        case.attempts += 1;
+        case.state = CaseState::InFlight {
+            worker,
+            since: Instant::now(),
+        };
+    }
+
+    /// Case `i` waits for a worker again (its worker died or sent a bad
+    /// result: the attempt counts). A recorded case stays recorded.
+    pub fn requeue(&mut self, i: usize) {
+        if self.cases[i].state != CaseState::Done {
+            self.cases[i].state = CaseState::Pending;
+        }
+    }
+
+    /// Case `i` came back unsolved from a worker that moved on (handed back,
+    /// not crashed on): pending again, and the attempt does not count.
+    pub fn hand_back(&mut self, i: usize) {
+        if self.cases[i].state != CaseState::Done {
+            self.cases[i].state = CaseState::Pending;
+            self.cases[i].attempts = self.cases[i].attempts.saturating_sub(1);
+        }
+    }
+
+    /// Case `i` is recorded; only `record::Recorder` calls this.
+    pub(super) fn mark_done(&mut self, i: usize) {
+        self.cases[i].state = CaseState::Done;
+    }
+
+    /// The worker case `i` is in flight to, and for how long.
+    pub fn in_flight(&self, i: usize) -> Option<(usize, std::time::Duration)> {
+        match self.cases[i].state {
+            CaseState::InFlight { worker, since } => Some((worker, since.elapsed())),
+            _ => None,
+        }
     }
 
     /// Cases not yet recorded.
@@ -142,12 +196,16 @@ mod tests {
         }
     }
 
+    fn key(material: &str, surface: &str, angle: f64) -> CaseKey {
+        CaseKey::new(material, surface, angle)
+    }
+
     fn plan() -> Plan {
         Plan::new(vec![
-            ("A/flat/000.0".into(), spec("A", 0.0)),
-            ("A/flat/045.0".into(), spec("A", 45.0)),
-            ("B/flat/000.0".into(), spec("B", 0.0)),
-            ("B/flat/045.0".into(), spec("B", 45.0)),
+            (key("A", "flat", 0.0), spec("A", 0.0)),
+            (key("A", "flat", 45.0), spec("A", 45.0)),
+            (key("B", "flat", 0.0), spec("B", 0.0)),
+            (key("B", "flat", 45.0), spec("B", 45.0)),
         ])
     }
 
@@ -158,7 +216,7 @@ mod tests {
         assert_eq!(first, 0);
         let a: HashSet<KernelKey> = [p.cases[0].kernel_key.clone()].into();
         let second = p.pick(&HashSet::new(), &a).unwrap();
-        assert_eq!(p.cases[second].id, "B/flat/000.0");
+        assert_eq!(p.cases[second].key.to_string(), "B/flat/000.0");
     }
 
     #[test]
@@ -176,9 +234,9 @@ mod tests {
             lattice: solver::LatticeKind::Square,
         };
         let p = Plan::new(vec![
-            ("A/flat/000.0".into(), spec("A", 0.0)),
-            ("C/circle-A/000.0".into(), patterned),
-            ("C/flat/000.0".into(), aniso),
+            (key("A", "flat", 0.0), spec("A", 0.0)),
+            (key("C", "circle-A", 0.0), patterned),
+            (key("C", "flat", 0.0), aniso),
         ]);
         let own: HashSet<KernelKey> = [p.cases[0].kernel_key.clone()].into();
         assert_eq!(p.pick(&own, &HashSet::new()), Some(2));
@@ -199,5 +257,33 @@ mod tests {
         }
         assert_eq!(p.pick(&a, &b), None);
         assert_eq!(p.remaining(), 0);
+    }
+
+    #[test]
+    fn cases_are_found_by_key_and_old_journals_by_display_text() {
+        let p = plan();
+        assert_eq!(p.index_of(&key("B", "flat", 45.0)), Some(3));
+        assert_eq!(p.index_of(&key("B", "flat", 46.0)), None);
+        assert_eq!(p.index_of_display("A/flat/045.0"), Some(1));
+        assert_eq!(p.index_of_display("A/flat/45"), None);
+    }
+
+    #[test]
+    fn a_recorded_case_is_never_requeued() {
+        let mut p = plan();
+        p.dispatched(0, 1);
+        assert_eq!(p.in_flight(0).map(|(w, _)| w), Some(1));
+        assert_eq!(p.cases[0].attempts, 1);
+        p.hand_back(0);
+        assert_eq!(
+            (p.cases[0].state.clone(), p.cases[0].attempts),
+            (CaseState::Pending, 0)
+        );
+        p.dispatched(0, 1);
+        p.mark_done(0);
+        p.requeue(0);
+        p.hand_back(0);
+        assert_eq!(p.cases[0].state, CaseState::Done);
+        assert_eq!(p.remaining(), 3);
     }
 }

@@ -1,0 +1,138 @@
+//! A case's identity ([`CaseKey`]) and how it ended ([`Status`]): the one
+//! definition used by the config, the plan, the journal, the outputs and
+//! `solve`. Owns no files, no IPC and no physics.
+//!
+//! The key's `Display` text (`Cu/flat/015.0`) is for people (progress lines,
+//! logs, `fields/<case>/`, the journal's `case_id`); nothing parses it back.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// Which case of a sweep: material × surface × force angle, by the names
+/// the config uses.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseKey {
+    /// Material name (a preset or a `[materials.*]` key).
+    pub material: String,
+    /// Surface name (a preset or a `[surfaces.*]` key).
+    pub surface: String,
+    /// Force direction, degrees.
+    pub angle_deg: f64,
+}
+
+impl CaseKey {
+    /// The key of `material` × `surface` × `angle_deg`.
+    pub fn new(material: &str, surface: &str, angle_deg: f64) -> Self {
+        CaseKey {
+            material: material.to_string(),
+            surface: surface.to_string(),
+            angle_deg,
+        }
+    }
+
+    /// The angle as it appears in the display text: `015.0`.
+    pub fn angle_text(&self) -> String {
+        format!("{:05.1}", self.angle_deg)
+    }
+}
+
+impl fmt::Display for CaseKey {
+    /// `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}/{}/{}",
+            self.material,
+            self.surface,
+            self.angle_text()
+        )
+    }
+}
+
+/// How a recorded case ended. Written as `ok`, `not_converged`, `failed`
+/// (results.csv, journal, case.json); journals of older builds that wrote
+/// `not-converged` still read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Solved, every loop converged.
+    Ok,
+    /// Solved, but a loop missed its tolerance; excluded from curves.
+    #[serde(alias = "not-converged")]
+    NotConverged,
+    /// No usable result (solver refusal, invalid result, dead worker).
+    Failed,
+}
+
+impl Status {
+    /// `Ok` when converged, `NotConverged` otherwise.
+    pub fn of_solved(converged: bool) -> Self {
+        if converged {
+            Status::Ok
+        } else {
+            Status::NotConverged
+        }
+    }
+
+    /// The text written to files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::NotConverged => "not_converged",
+            Status::Failed => "failed",
+        }
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn key_displays_as_the_historic_case_id() {
+        assert_eq!(
+            CaseKey::new("Cu(111)", "circle-A", 15.0).to_string(),
+            "Cu(111)/circle-A/015.0"
+        );
+        assert_eq!(
+            CaseKey::new("Fe", "flat", 180.0).to_string(),
+            "Fe/flat/180.0"
+        );
+    }
+
+    #[test]
+    fn key_round_trips_through_json_bit_exactly() {
+        let k = CaseKey::new("Cu", "flat", 1.0 / 3.0);
+        let back: CaseKey = serde_json::from_str(&serde_json::to_string(&k).unwrap()).unwrap();
+        assert_eq!(back.angle_deg.to_bits(), k.angle_deg.to_bits());
+        assert_eq!(back, k);
+    }
+
+    #[test]
+    fn status_text_and_old_spelling() {
+        for (s, t) in [
+            (Status::Ok, "ok"),
+            (Status::NotConverged, "not_converged"),
+            (Status::Failed, "failed"),
+        ] {
+            assert_eq!(s.to_string(), t);
+            assert_eq!(serde_json::to_string(&s).unwrap(), format!("\"{t}\""));
+            assert_eq!(
+                serde_json::from_str::<Status>(&format!("\"{t}\"")).unwrap(),
+                s
+            );
+        }
+        assert_eq!(
+            serde_json::from_str::<Status>("\"not-converged\"").unwrap(),
+            Status::NotConverged
+        );
+        assert!(serde_json::from_str::<Status>("\"fine\"").is_err());
+    }
+}

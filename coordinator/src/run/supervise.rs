@@ -1,0 +1,208 @@
+//! Worker processes: starting the ones this coordinator owns (logs in
+//! `worker-logs/`), watching them, and the verdict on any worker's liveness
+//! (process exited, node gone, case past its deadline). Must not touch IPC
+//! messages, the plan or the journal: it judges, `dispatch` acts.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use iceoryx2::node::NodeView;
+use iceoryx2::prelude::*;
+
+use super::exchange::Exchange;
+
+/// What the supervisor starts workers with.
+pub struct SuperviseArgs<'a> {
+    /// Run id (`worker --run`).
+    pub run_id: &'a str,
+    /// The `mpcontact` binary.
+    pub exe: &'a Path,
+    /// Output directory (`worker-logs/` goes there).
+    pub out_dir: &'a Path,
+    /// Workers of the run; replacements are limited to `2 × workers + 2`
+    /// starts in all.
+    pub workers: usize,
+    /// Floor of the per-case deadline (`run.case_timeout_s`).
+    pub case_timeout: Duration,
+}
+
+/// The worker processes of a run and the case deadline.
+pub struct Supervisor<'a> {
+    args: SuperviseArgs<'a>,
+    children: BTreeMap<usize, Child>,
+    next_index: usize,
+    spawns_left: usize,
+    /// Longest dispatch → record time of a case seen so far.
+    longest_case: Duration,
+}
+
+/// Which worker nodes of the system were alive at one listing.
+pub struct NodeSurvey {
+    /// Node name → some node of that name is alive.
+    alive: HashMap<String, bool>,
+    /// The listing succeeded (otherwise node liveness is not trusted).
+    listed: bool,
+}
+
+/// The supervisor's verdict on one worker.
+pub enum Verdict {
+    /// Nothing wrong seen.
+    Alive,
+    /// Its case has been in flight past the deadline.
+    Hung {
+        /// How long the case has been in flight.
+        took: Duration,
+        /// The deadline it passed.
+        deadline: Duration,
+    },
+    /// Its process exited or its node is gone.
+    Gone,
+}
+
+impl<'a> Supervisor<'a> {
+    /// A supervisor with no worker started yet.
+    pub fn new(args: SuperviseArgs<'a>) -> Self {
+        Supervisor {
+            spawns_left: args.workers * 2 + 2,
+            args,
+            children: BTreeMap::new(),
+            next_index: 0,
+            longest_case: Duration::ZERO,
+        }
+    }
+
+    /// Start worker `k` (the next index) as `EXE worker --run RUN --index K`;
+    /// returns `k`.
+    pub fn spawn(&mut self) -> anyhow::Result<usize> {
+        let k = self.next_index;
+        self.next_index += 1;
+        self.spawns_left = self.spawns_left.saturating_sub(1);
+        let log_dir = self.args.out_dir.join("worker-logs");
+        std::fs::create_dir_all(&log_dir)?;
+        let log = std::fs::File::create(log_dir.join(format!("worker-{k}.log")))?;
+        let child = Command::new(self.args.exe)
+            .args([
+                "worker",
+                "--run",
+                self.args.run_id,
+                "--index",
+                &k.to_string(),
+            ])
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log)
+            .spawn()
+            .with_context(|| format!("while starting worker {k} ({})", self.args.exe.display()))?;
+        self.children.insert(k, child);
+        Ok(k)
+    }
+
+    /// A replacement may still be started.
+    pub fn may_spawn(&self) -> bool {
+        self.spawns_left > 0
+    }
+
+    /// Worker `k` was started (and may be killed) by this coordinator.
+    pub fn owns(&self, k: usize) -> bool {
+        self.children.contains_key(&k)
+    }
+
+    /// Whether the process of worker `k` has exited; `None` when it is not
+    /// ours (started by hand, or already reaped by [`Supervisor::stop`]).
+    pub fn exited(&mut self, k: usize) -> Option<bool> {
+        self.children
+            .get_mut(&k)
+            .map(|c| matches!(c.try_wait(), Ok(Some(_))))
+    }
+
+    /// Kill worker `k` if it is ours, and reap it.
+    pub fn stop(&mut self, k: usize) {
+        if let Some(mut c) = self.children.remove(&k) {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+
+    /// List the nodes of the system (and clean up after dead ones).
+    pub fn survey(&self, exchange: &Exchange) -> NodeSurvey {
+        let mut alive: HashMap<String, bool> = HashMap::new();
+        let mut saw_dead = false;
+        let listed = Node::<ipc::Service>::list(exchange.config(), |st| {
+            let (is_alive, details) = match &st {
+                NodeState::Alive(v) => (true, v.details().clone()),
+                NodeState::Dead(v) => (false, v.details().clone()),
+                _ => return CallbackProgression::Continue,
+            };
+            saw_dead |= !is_alive;
+            if let Some(d) = details {
+                let e = alive.entry(d.name().as_str().to_string()).or_insert(false);
+                *e |= is_alive;
+            }
+            CallbackProgression::Continue
+        });
+        if saw_dead {
+            exchange.cleanup_dead_nodes();
+        }
+        NodeSurvey {
+            alive,
+            listed: listed.is_ok(),
+        }
+    }
+
+    /// A case was recorded after `took` in flight (raises the deadline).
+    pub fn case_finished(&mut self, took: Duration) {
+        self.longest_case = self.longest_case.max(took);
+    }
+
+    /// How long a case may be in flight before its worker counts as hung:
+    /// max(`run.case_timeout_s`, HUNG_FACTOR × the longest case so far).
+    pub fn case_deadline(&self) -> Duration {
+        self.args
+            .case_timeout
+            .max(self.longest_case.mul_f64(crate::config::HUNG_FACTOR))
+    }
+
+    /// Judge worker `k`: `registered` when it has sent a message (only then
+    /// is a missing node meaningful), `in_flight_for` how long its case has
+    /// been in flight to it.
+    pub fn verdict(
+        &mut self,
+        k: usize,
+        registered: bool,
+        in_flight_for: Option<Duration>,
+        survey: &NodeSurvey,
+    ) -> Verdict {
+        let deadline = self.case_deadline();
+        if let Some(took) = in_flight_for {
+            if took > deadline {
+                return Verdict::Hung { took, deadline };
+            }
+        }
+        let exited = self.exited(k).unwrap_or(false);
+        let name = protocol::worker_node_name(self.args.run_id, k);
+        let node_alive = survey.alive.get(&name).copied().unwrap_or(false);
+        // Trust the node list only when it could be read.
+        if exited || (survey.listed && registered && !node_alive) {
+            Verdict::Gone
+        } else {
+            Verdict::Alive
+        }
+    }
+
+    /// Give the workers 2 s to exit after `Done`, then kill the stragglers.
+    pub fn stop_all(&mut self) {
+        let deadline = Instant::now() + Duration::from_secs(2);
+        for c in self.children.values_mut() {
+            while Instant::now() < deadline && matches!(c.try_wait(), Ok(None)) {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            if matches!(c.try_wait(), Ok(None)) {
+                let _ = c.kill();
+            }
+            let _ = c.wait();
+        }
+    }
+}
