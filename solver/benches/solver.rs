@@ -6,29 +6,14 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use solver::operator::{X, Y, Z};
-use solver::{build_operator, solve_case, CaseSpec, Grid, KernelCache, Load, Numerics, Surface};
+use solver::{build_operator, solve_case, CaseSpec, Grid, KernelCache};
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+/// Paper Table 1a (isotropic Fe, coupled) on `n` cells of a 256 µm domain.
 fn table_1a(n: usize, ratio: f64) -> CaseSpec {
-    CaseSpec {
-        material: solver::presets::material("Fe").unwrap(),
-        surface: Surface::Flat,
-        grid: Grid::square(n, 0.5e-6 * 512.0 / n as f64),
-        load: Load {
-            indenter_radius_m: 18.0e-3,
-            normal_force_n: 20.0,
-            friction: 0.28571,
-            tangential_ratio: ratio,
-            angle_deg: 0.0,
-        },
-        numerics: Numerics {
-            coupling: true,
-            tolerance: 1e-10,
-            tangential_tolerance: 1e-6,
-            max_iterations: 5000,
-            coupling_tolerance: 1e-8,
-            max_coupling_iterations: 50,
-        },
-    }
+    common::table_1a_fe(n, 0.5 * 512.0 / n as f64, true, ratio)
 }
 
 fn operator_apply(c: &mut Criterion) {

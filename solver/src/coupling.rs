@@ -12,7 +12,7 @@ use crate::kernels::Resident;
 use crate::normal::{NormalProblem, NormalReport, NormalSolution};
 use crate::operator::{X, Y, Z};
 use crate::spec::CaseSpec;
-use crate::tangential::{TangentialProblem, TangentialReport, TangentialStart};
+use crate::tangential::{TangentialProblem, TangentialReport, TangentialSolution, TangentialStart};
 
 /// History depth of the Anderson mixing of the coupling loop.
 const ANDERSON_DEPTH: usize = 3;
@@ -81,28 +81,17 @@ impl Anderson {
     }
 }
 
-/// Tractions, slip and convergence of a case after its partial-slip solve.
+/// Pressure, tractions, slip and convergence of a case after its partial-slip solve.
 pub(crate) struct ContactState {
     /// Pressure, Pa.
     pub p: Vec<f64>,
-    /// Shear tractions, Pa.
-    pub qx: Vec<f64>,
-    /// Shear tractions, Pa.
-    pub qy: Vec<f64>,
-    /// Slip, m.
-    pub sx: Vec<f64>,
-    /// Slip, m.
-    pub sy: Vec<f64>,
-    /// Stick cells (all contact cells without a tangential force).
-    pub stick: Vec<bool>,
-    /// Rigid tangential shift δt, m.
-    pub shift: [f64; 2],
     /// Rigid-body approach δz, m.
     pub approach: f64,
+    /// The last tangential solution (without a tangential force: no
+    /// tractions, every contact cell sticks).
+    pub tangential: TangentialSolution,
     /// Report of the last normal solve.
     pub normal_report: NormalReport,
-    /// Report of the last tangential solve.
-    pub tangential_report: TangentialReport,
     /// Normal iterations, summed over coupling passes.
     pub normal_iterations: usize,
     /// Tangential iterations, summed over coupling passes.
@@ -137,15 +126,19 @@ pub(crate) fn solve_partial_slip(
     let force = spec.load.tangential_force();
     let fnorm = force[0].hypot(force[1]);
 
-    let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
-    let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
-    let mut stick: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
-    let mut shift = [0.0; 2];
-    let mut tangential_iterations = 0;
-    let mut tan_report = TangentialReport {
-        converged: true,
-        ..Default::default()
+    let mut tan = TangentialSolution {
+        qx: vec![0.0; len],
+        qy: vec![0.0; len],
+        sx: vec![0.0; len],
+        sy: vec![0.0; len],
+        stick: p.iter().map(|&v| v > 0.0).collect(),
+        shift: [0.0; 2],
+        report: TangentialReport {
+            converged: true,
+            ..Default::default()
+        },
     };
+    let mut tangential_iterations = 0;
     let mut coupling_iterations = 0;
     let mut coupling_change = 0.0;
     let mut coupling_converged = true;
@@ -193,7 +186,7 @@ pub(crate) fn solve_partial_slip(
                     .apply(&[(Z, &hq)], &mut [(X, &mut ex), (Y, &mut ey)]);
             }
             // The previous pass's slip is not an input: free it meanwhile.
-            drop((std::mem::take(&mut sx), std::mem::take(&mut sy)));
+            drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
             let sol = res.solve_tangential(&TangentialProblem {
                 p: &p,
                 friction: spec.load.friction,
@@ -202,25 +195,19 @@ pub(crate) fn solve_partial_slip(
                 tolerance: tan_tol,
                 max_iterations: num.max_iterations,
                 start: if have_q {
-                    TangentialStart::Tractions(&qx, &qy)
+                    TangentialStart::Tractions(&tan.qx, &tan.qy)
                 } else {
                     TangentialStart::Proportional
                 },
             })?;
             have_q = true;
             tangential_iterations += sol.report.iterations;
-            tan_report = sol.report;
-            qx = sol.qx;
-            qy = sol.qy;
-            sx = sol.sx;
-            sy = sol.sy;
-            stick = sol.stick;
-            shift = sol.shift;
+            tan = sol;
             if !num.coupling || coupling_converged {
                 break;
             }
             res.operator
-                .apply(&[(X, &qx), (Y, &qy)], &mut [(Z, &mut hq)]);
+                .apply(&[(X, &tan.qx), (Y, &tan.qy)], &mut [(Z, &mut hq)]);
             // Anderson mixing of the coupling gap uz(q) while the loop is far
             // from converged; plain (Picard) passes at the end, so the
             // convergence test below is the fixed-point test of the plain loop.
@@ -256,15 +243,9 @@ pub(crate) fn solve_partial_slip(
     }
     Ok(ContactState {
         p,
-        qx,
-        qy,
-        sx,
-        sy,
-        stick,
-        shift,
         approach,
+        tangential: tan,
         normal_report,
-        tangential_report: tan_report,
         normal_iterations,
         tangential_iterations,
         coupling_iterations,

@@ -11,7 +11,7 @@ use crate::geometry::{equivalent_radius, hull_area};
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
 use crate::spec::{CaseSpec, Load};
-use crate::tangential::TangentialReport;
+use crate::tangential::{TangentialReport, TangentialSolution};
 
 /// The scalars of one solved case.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -171,15 +171,9 @@ pub(crate) fn reduce(
 ) -> Result<CaseOutput, SolverError> {
     let ContactState {
         p,
-        qx,
-        qy,
-        sx,
-        sy,
-        stick,
-        shift,
         approach,
+        tangential,
         normal_report,
-        tangential_report: tan_report,
         normal_iterations,
         tangential_iterations,
         coupling_iterations,
@@ -191,6 +185,15 @@ pub(crate) fn reduce(
     let load = spec.load.normal_force_n;
     let force = spec.load.tangential_force();
     let fnorm = force[0].hypot(force[1]);
+    let TangentialSolution {
+        qx,
+        qy,
+        sx,
+        sy,
+        stick,
+        shift,
+        report: tan_report,
+    } = tangential;
     // Total displacements from all tractions.
     let (mut ux, mut uy, mut uz) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
     op.apply(

@@ -19,12 +19,8 @@ fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64
             angle_deg: angle,
         },
         numerics: Numerics {
-            coupling: true,
-            tolerance: 1e-10,
-            tangential_tolerance: 1e-6,
-            max_iterations: 5000,
             coupling_tolerance: 1e-8,
-            max_coupling_iterations: 50,
+            ..Numerics::default()
         },
     }
 }

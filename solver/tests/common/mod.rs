@@ -21,11 +21,8 @@ pub fn table_1a_fe(n: usize, spacing_um: f64, coupling: bool, ratio: f64) -> Cas
         },
         numerics: Numerics {
             coupling,
-            tolerance: 1e-10,
-            tangential_tolerance: 1e-6,
-            max_iterations: 5000,
             coupling_tolerance: 1e-8,
-            max_coupling_iterations: 50,
+            ..Numerics::default()
         },
     }
 }
