@@ -467,6 +467,7 @@ impl Config {
             bail!("run.case_timeout_s = {t}: must be a positive number of seconds");
         }
         let angles = self.sweep.angles_deg.values()?;
+        self.check_unique(&angles)?;
         for m in &self.sweep.materials {
             for s in &self.sweep.surfaces {
                 for &a in &angles {
@@ -484,6 +485,32 @@ impl Config {
                 self.grid.points,
                 bytes / 1024f64.powi(3)
             );
+        }
+        Ok(())
+    }
+
+    /// Every case must have its own identity: no material or surface listed
+    /// twice, and no two angles that case ids and outputs (0.1°) cannot tell
+    /// apart. (Repeated keys made `run` re-send a case forever, #20 item 1.)
+    fn check_unique(&self, angles: &[f64]) -> Result<()> {
+        for (key, names) in [
+            ("sweep.materials", &self.sweep.materials),
+            ("sweep.surfaces", &self.sweep.surfaces),
+        ] {
+            let mut seen = std::collections::HashSet::new();
+            if let Some(name) = names.iter().find(|n| !seen.insert(n.as_str())) {
+                bail!("{key}: `{name}` is listed twice; every case must be unique");
+            }
+        }
+        // The text the ids show; `+ 0.0` makes −0 and 0 the same angle.
+        let mut shown: BTreeMap<String, f64> = BTreeMap::new();
+        for &a in angles {
+            let text = format!("{:.1}", a + 0.0);
+            if let Some(prev) = shown.insert(text.clone(), a) {
+                bail!(
+                    "sweep.angles_deg: {prev}° and {a}° both read {text}° in case ids and outputs, which resolve 0.1°; give angles at least 0.1° apart"
+                );
+            }
         }
         Ok(())
     }
@@ -791,6 +818,46 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         let nan_h = format!("{BASE}\n[surfaces.odd]\nshape = \"square\"\nside_um = 10.0\npitch_um = 40.0\nheight_um = nan\n")
             .replace("surfaces = [\"flat\"]", "surfaces = [\"odd\"]");
         assert!(err(&nan_h, &[]).contains("height"), "{}", err(&nan_h, &[]));
+    }
+
+    #[test]
+    fn issue20_item1_repeated_cases_are_refused_naming_them() {
+        let cases: [(&str, &str, &str); 6] = [
+            ("materials = [\"Fe\"]", "materials = [\"Fe\", \"Fe\"]", "`Fe` is listed twice"),
+            ("surfaces = [\"flat\"]", "surfaces = [\"flat\", \"flat\"]", "sweep.surfaces"),
+            (
+                "angles_deg = { start = 0, stop = 90, step = 45 }",
+                "angles_deg = [0.0, 0.0]",
+                "sweep.angles_deg",
+            ),
+            (
+                "angles_deg = { start = 0, stop = 90, step = 45 }",
+                "angles_deg = [0.0, 0.01]",
+                "0° and 0.01° both read 0.0°",
+            ),
+            (
+                "angles_deg = { start = 0, stop = 90, step = 45 }",
+                "angles_deg = { start = 0, stop = 1, step = 0.04 }",
+                "sweep.angles_deg",
+            ),
+            (
+                "angles_deg = { start = 0, stop = 90, step = 45 }",
+                "angles_deg = [-0.0, 0.0]",
+                "sweep.angles_deg",
+            ),
+        ];
+        for (from, to, expect) in cases {
+            let text = BASE.replace(from, to);
+            assert_ne!(text, BASE, "{to}");
+            let e = err(&text, &[]);
+            assert!(e.contains(expect), "{to}: {e}");
+        }
+        // Angles 0.1° apart are distinct cases.
+        let ok = BASE.replace(
+            "angles_deg = { start = 0, stop = 90, step = 45 }",
+            "angles_deg = [0.0, 0.1, 0.2]",
+        );
+        assert_eq!(Config::parse(&ok, &[]).unwrap().cases().unwrap().len(), 3);
     }
 
     #[test]
