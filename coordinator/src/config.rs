@@ -48,8 +48,10 @@ fn default_ratio() -> f64 {
 }
 
 /// Force angles: `{ start, stop, step }` (stop included) or a list.
+/// Read through [`AnglesCfg::try_from`], so that a missing or unknown key of
+/// the range is named (serde's untagged enums only say that nothing matched).
 #[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, try_from = "toml::Value")]
 pub enum AnglesCfg {
     /// Inclusive range.
     Range {
@@ -64,6 +66,67 @@ pub enum AnglesCfg {
     List(Vec<f64>),
 }
 
+/// Most angles one sweep may list (a range or a list): 180° in 0.1° steps
+/// is 1801, so this only stops runaway inputs before they allocate.
+pub const MAX_ANGLES: usize = 100_000;
+
+impl TryFrom<toml::Value> for AnglesCfg {
+    type Error = String;
+
+    fn try_from(v: toml::Value) -> std::result::Result<Self, String> {
+        let number = |v: &toml::Value, what: &str| match v {
+            toml::Value::Float(x) => Ok(*x),
+            toml::Value::Integer(i) => Ok(*i as f64),
+            other => Err(format!(
+                "{what} must be a number of degrees, got {}",
+                other.type_str()
+            )),
+        };
+        match v {
+            toml::Value::Array(items) => {
+                if items.len() > MAX_ANGLES {
+                    return Err(format!(
+                        "{} angles is too many (at most {MAX_ANGLES})",
+                        items.len()
+                    ));
+                }
+                let list = items
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| number(x, &format!("entry {i}")))
+                    .collect::<std::result::Result<_, _>>()?;
+                Ok(AnglesCfg::List(list))
+            }
+            toml::Value::Table(t) => {
+                if let Some(k) = t
+                    .keys()
+                    .find(|k| !["start", "stop", "step"].contains(&k.as_str()))
+                {
+                    return Err(format!(
+                        "unknown key `{k}` in the range (expected start, stop, step)"
+                    ));
+                }
+                let get = |k: &str| {
+                    t.get(k)
+                        .ok_or_else(|| {
+                            format!("the range needs `{k}` (start, stop, step in degrees)")
+                        })
+                        .and_then(|v| number(v, k))
+                };
+                Ok(AnglesCfg::Range {
+                    start: get("start")?,
+                    stop: get("stop")?,
+                    step: get("step")?,
+                })
+            }
+            other => Err(format!(
+                "expected a list of angles or {{ start, stop, step }}, got {}",
+                other.type_str()
+            )),
+        }
+    }
+}
+
 impl AnglesCfg {
     /// The angles, degrees.
     pub fn values(&self) -> Result<Vec<f64>> {
@@ -71,6 +134,12 @@ impl AnglesCfg {
             AnglesCfg::List(v) => {
                 if v.is_empty() || v.iter().any(|a| !a.is_finite()) {
                     bail!("sweep.angles_deg: the list must be non-empty and finite");
+                }
+                if v.len() > MAX_ANGLES {
+                    bail!(
+                        "sweep.angles_deg: {} angles is too many (at most {MAX_ANGLES})",
+                        v.len()
+                    );
                 }
                 Ok(v.clone())
             }
@@ -81,11 +150,17 @@ impl AnglesCfg {
                 {
                     bail!("sweep.angles_deg: need finite start ≤ stop and step > 0, got start = {start}, stop = {stop}, step = {step}");
                 }
-                let count = ((stop - start) / step + 1e-9).floor() as usize + 1;
-                if count > 100_000 {
-                    bail!("sweep.angles_deg: {count} angles is too many");
+                // Counted in floating point: (stop − start)/step can exceed
+                // any integer (step = 1e-300), and must not wrap to zero.
+                let count = ((stop - start) / step + 1e-9).floor() + 1.0;
+                if count > MAX_ANGLES as f64 {
+                    bail!(
+                        "sweep.angles_deg: start = {start}, stop = {stop}, step = {step} gives {count:.3e} angles, too many (at most {MAX_ANGLES})"
+                    );
                 }
-                Ok((0..count).map(|k| start + k as f64 * step).collect())
+                Ok((0..count as usize)
+                    .map(|k| start + k as f64 * step)
+                    .collect())
             }
         }
     }
@@ -463,8 +538,9 @@ impl Config {
         }
         self.sweep.angles_deg.values()?;
         let t = self.run.case_timeout_s;
-        if !(t.is_finite() && t > 0.0) {
-            bail!("run.case_timeout_s = {t}: must be a positive number of seconds");
+        // 1e9 s (32 years) keeps the deadline within what a Duration holds.
+        if !(t.is_finite() && t > 0.0 && t <= 1e9) {
+            bail!("run.case_timeout_s = {t}: must be a positive number of seconds, at most 1e9");
         }
         let angles = self.sweep.angles_deg.values()?;
         self.check_unique(&angles)?;
@@ -823,8 +899,16 @@ angles_deg = { start = 0, stop = 90, step = 45 }
     #[test]
     fn issue20_item1_repeated_cases_are_refused_naming_them() {
         let cases: [(&str, &str, &str); 6] = [
-            ("materials = [\"Fe\"]", "materials = [\"Fe\", \"Fe\"]", "`Fe` is listed twice"),
-            ("surfaces = [\"flat\"]", "surfaces = [\"flat\", \"flat\"]", "sweep.surfaces"),
+            (
+                "materials = [\"Fe\"]",
+                "materials = [\"Fe\", \"Fe\"]",
+                "`Fe` is listed twice",
+            ),
+            (
+                "surfaces = [\"flat\"]",
+                "surfaces = [\"flat\", \"flat\"]",
+                "sweep.surfaces",
+            ),
             (
                 "angles_deg = { start = 0, stop = 90, step = 45 }",
                 "angles_deg = [0.0, 0.0]",
@@ -861,9 +945,56 @@ angles_deg = { start = 0, stop = 90, step = 45 }
     }
 
     #[test]
+    fn issue20_item6_angle_counts_and_timeouts_are_bounded() {
+        let range = "angles_deg = { start = 0, stop = 90, step = 45 }";
+        let e = err(
+            &BASE.replace(
+                range,
+                "angles_deg = { start = 0, stop = 180, step = 1e-300 }",
+            ),
+            &[],
+        );
+        assert!(
+            e.contains("sweep.angles_deg") && e.contains("too many"),
+            "{e}"
+        );
+        let long: Vec<String> = (0..MAX_ANGLES + 1).map(|i| format!("{i}.0")).collect();
+        let e = err(
+            &BASE.replace(range, &format!("angles_deg = [{}]", long.join(","))),
+            &[],
+        );
+        assert!(e.contains("too many"), "{}", &e[..e.len().min(300)]);
+        let e = err(&format!("{BASE}\n[run]\ncase_timeout_s = 1e20\n"), &[]);
+        assert!(e.contains("run.case_timeout_s"), "{e}");
+    }
+
+    #[test]
+    fn issue20_item7_range_keys_are_named() {
+        let range = "angles_deg = { start = 0, stop = 90, step = 45 }";
+        let e = err(
+            &BASE.replace(range, "angles_deg = { start = 0, stop = 90 }"),
+            &[],
+        );
+        assert!(e.contains("needs `step`") && e.contains("line"), "{e}");
+        let e = err(
+            &BASE.replace(
+                range,
+                "angles_deg = { start = 0, stop = 90, step = 45, extra = 1 }",
+            ),
+            &[],
+        );
+        assert!(e.contains("unknown key `extra`"), "{e}");
+        let e = err(&BASE.replace(range, "angles_deg = \"all\""), &[]);
+        assert!(e.contains("expected a list of angles"), "{e}");
+        // Integers are degrees too.
+        let ok = Config::parse(&BASE.replace(range, "angles_deg = [0, 45]"), &[]).unwrap();
+        assert_eq!(ok.sweep.angles_deg.values().unwrap(), [0.0, 45.0]);
+    }
+
+    #[test]
     fn heightmap_surface_is_read_from_npy_and_its_shape_checked() {
-        let dir = std::env::temp_dir().join(format!("mpcontact-hmap-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp_dir = tempfile::tempdir().unwrap();
+        let dir = tmp_dir.path().to_path_buf();
         let heights: Vec<f64> = (0..64 * 64)
             .map(|i| if i % 7 == 0 { 0.5 } else { 0.0 })
             .collect();
@@ -883,7 +1014,6 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         let missing = text.replace("h.npy", "nope.npy");
         let e = format!("{:#}", Config::parse_in(&missing, &[], &dir).unwrap_err());
         assert!(e.contains("surfaces.rough.file"), "{e}");
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

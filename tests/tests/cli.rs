@@ -28,11 +28,12 @@ fn run(args: &[&str]) -> Output {
         .expect("run mpcontact")
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mpcontact-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    // Removed when dropped: the tests leave nothing in the system temp dir.
+    tempfile::Builder::new()
+        .prefix(&format!("mpcontact-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 const SMALL: &str = r#"
@@ -56,7 +57,8 @@ angles_deg = [30.0]
 
 #[test]
 fn solve_writes_case_json_nine_npy_fields_and_five_maps() {
-    let dir = temp_dir("solve");
+    let tmp_dir = temp_dir("solve");
+    let dir = tmp_dir.path().to_path_buf();
     std::fs::write(dir.join("c.toml"), SMALL).unwrap();
     let out = run(&[
         "solve",
@@ -108,7 +110,8 @@ fn solve_writes_case_json_nine_npy_fields_and_five_maps() {
 }
 
 fn expect_error(config: &str, sets: &[&str], needle: &str) {
-    let dir = temp_dir(&format!("bad{}", needle.len()));
+    let tmp_dir = temp_dir(&format!("bad{}", needle.len()));
+    let dir = tmp_dir.path().to_path_buf();
     std::fs::write(dir.join("c.toml"), config).unwrap();
     let mut args = vec![
         "solve".to_string(),

@@ -346,8 +346,7 @@ mod tests {
 
     #[test]
     fn second_cache_loads_the_stored_kernel_and_gives_identical_results() {
-        let dir = std::env::temp_dir().join(format!("mpcontact-kstore-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let (_tmp, dir) = private_store();
         let mut first = solver::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
         let a = solve_case(&spec(), &mut first).unwrap();
         assert_eq!((first.builds(), first.loads()), (1, 0));
@@ -371,7 +370,6 @@ mod tests {
         let c = solve_case(&spec(), &mut third).unwrap();
         assert_eq!(third.loads(), 0);
         assert_eq!(a.fields.p, c.fields.p);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// A store in a fresh private temporary directory (removed on drop).

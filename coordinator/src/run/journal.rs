@@ -242,11 +242,12 @@ impl Journal {
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("mpc-journal-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn tmp(name: &str) -> tempfile::TempDir {
+        // Removed when dropped: tests leave nothing in the system temp dir.
+        tempfile::Builder::new()
+            .prefix(&format!("mpc-{name}-"))
+            .tempdir()
+            .unwrap()
     }
 
     fn rec(id: &str) -> Entry {
@@ -265,7 +266,8 @@ mod tests {
 
     #[test]
     fn resume_reads_records_and_drops_torn_tail() {
-        let d = tmp("torn");
+        let tmp_dir = tmp("torn");
+        let d = tmp_dir.path().to_path_buf();
         {
             let (mut j, prev) = Journal::open(&d, "r1", "cfg", false).unwrap();
             assert!(prev.entries.is_empty());
@@ -313,7 +315,8 @@ mod tests {
 
     #[test]
     fn resume_with_other_config_is_refused_naming_the_line() {
-        let d = tmp("cfg");
+        let tmp_dir = tmp("cfg");
+        let d = tmp_dir.path().to_path_buf();
         drop(Journal::open(&d, "r1", "a = 1\nb = 2\n", false).unwrap());
         let err = Journal::open(&d, "r2", "a = 1\nb = 3\n", true)
             .err()

@@ -168,16 +168,18 @@ mod tests {
         }
     }
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("mpc-record-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn tmp(name: &str) -> tempfile::TempDir {
+        // Removed when dropped: tests leave nothing in the system temp dir.
+        tempfile::Builder::new()
+            .prefix(&format!("mpc-{name}-"))
+            .tempdir()
+            .unwrap()
     }
 
     #[test]
     fn a_case_is_recorded_once_and_resumes_by_key() {
-        let d = tmp("once");
+        let tmp_dir = tmp("once");
+        let d = tmp_dir.path().to_path_buf();
         let (mut rec, resumed) = Recorder::open(plan(), &d, "r1", "cfg", false).unwrap();
         assert_eq!(resumed.cases, 0);
         rec.dispatched(1, 0);
@@ -197,7 +199,8 @@ mod tests {
 
     #[test]
     fn an_old_journal_resumes_by_display_text() {
-        let d = tmp("old");
+        let tmp_dir = tmp("old");
+        let d = tmp_dir.path().to_path_buf();
         drop(Recorder::open(plan(), &d, "r1", "cfg", false).unwrap());
         let old = "{\"kind\":\"case\",\"case_id\":\"Cu/flat/015.0\",\"status\":\"not-converged\",\
                    \"error\":null,\"worker\":1,\"seconds\":0.5,\"kernel_builds\":1,\"scalars\":null}\n";
@@ -212,7 +215,8 @@ mod tests {
 
     #[test]
     fn non_finite_scalars_are_recorded_as_failed() {
-        let d = tmp("nan");
+        let tmp_dir = tmp("nan");
+        let d = tmp_dir.path().to_path_buf();
         let (mut rec, _) = Recorder::open(plan(), &d, "r1", "cfg", false).unwrap();
         let mut bad = ok(0);
         if let Some(s) = bad.scalars.as_mut() {
