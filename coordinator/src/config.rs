@@ -3,7 +3,7 @@
 //! from the file). Units are in the key names; the cases carry SI.
 
 use crate::case::CaseKey;
-use crate::npy::read_npy_f64;
+use crate::npy::read_grid_npy;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use solver::{
@@ -386,6 +386,25 @@ pub struct Config {
     /// Directory that relative paths in the config (height maps) start from.
     #[serde(skip)]
     pub base_dir: std::path::PathBuf,
+    /// Surfaces already built, by name: a height map is read once per
+    /// config, not once per case (#20 item 5).
+    #[serde(skip)]
+    built_surfaces: SurfaceCache,
+}
+
+/// Built surfaces by name, shared by the clones of one config.
+#[derive(Clone, Debug, Default)]
+struct SurfaceCache(std::sync::Arc<std::sync::Mutex<BTreeMap<String, Surface>>>);
+
+impl SurfaceCache {
+    fn get(&self, name: &str) -> Option<Surface> {
+        let map = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        map.get(name).cloned()
+    }
+    fn insert(&self, name: &str, surface: &Surface) {
+        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        map.insert(name.to_string(), surface.clone());
+    }
 }
 
 /// Applies one `KEY=VALUE` override to a TOML table. VALUE is read as TOML
@@ -604,10 +623,14 @@ impl Config {
     /// Resolves a surface name: `[surfaces.NAME]` first, then presets.
     pub fn surface(&self, name: &str) -> Result<Surface> {
         if let Some(s) = self.surfaces.get(name) {
+            if let Some(surface) = self.built_surfaces.get(name) {
+                return Ok(surface);
+            }
             let surface = build_surface(name, s, self.grid.points, &self.base_dir)?;
             surface
                 .validate(self.grid.points)
                 .map_err(|e| self.explain(within("surface", e), "", name))?;
+            self.built_surfaces.insert(name, &surface);
             return Ok(surface);
         }
         solver::presets::surface(name).ok_or_else(|| {
@@ -674,6 +697,12 @@ fn build_material(
         bail!("materials.{name}: give exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`");
     }
     if let Some(iso) = m.isotropic {
+        if m.equivalent.is_some() {
+            bail!(
+                "{}: only applies to anisotropic materials (an isotropic material is its own equivalent)",
+                key("equivalent")
+            );
+        }
         if m.normal.is_some() || m.x_dir.is_some() {
             bail!(
                 "{}: `normal`/`x_dir` only apply to `cubic_gpa`",
@@ -752,17 +781,11 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
                 .as_ref()
                 .ok_or_else(|| anyhow!("surfaces.{name}.file: required for shape = \"heightmap\""))?;
             let path = base.join(file);
-            let (shape, values) = read_npy_f64(&path)
-                .with_context(|| format!("surfaces.{name}.file: cannot read {}", path.display()))?;
-            if shape != [n as u64, n as u64] {
-                bail!(
-                    "surfaces.{name}.file: {} has shape {shape:?} but the grid is {n} x {n} (grid.points)",
-                    path.display()
-                );
-            }
+            let values =
+                read_grid_npy(&path, n).with_context(|| format!("surfaces.{name}.file"))?;
             Surface::Heightmap {
                 n,
-                heights: values.iter().map(|v| v * um).collect(),
+                heights: std::sync::Arc::new(values.iter().map(|v| v * um).collect()),
             }
         }
         other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap)"),
@@ -966,6 +989,62 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         assert!(e.contains("too many"), "{}", &e[..e.len().min(300)]);
         let e = err(&format!("{BASE}\n[run]\ncase_timeout_s = 1e20\n"), &[]);
         assert!(e.contains("run.case_timeout_s"), "{e}");
+    }
+
+    #[test]
+    fn issue20_item8_equivalent_constants_are_checked_or_refused() {
+        let iso = format!(
+            "{BASE}\n[materials.soft]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nequivalent = {{ youngs_gpa = nan, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"soft\"]");
+        let e = err(&iso, &[]);
+        assert!(e.contains("materials.soft.equivalent"), "{e}");
+        let aniso = format!(
+            "{BASE}\n[materials.odd]\ncubic_gpa = {{ c11 = 257.1, c12 = 125.9, c44 = 108.6 }}\nnormal = [1, 1, 1]\nx_dir = [1, 1, -2]\nequivalent = {{ youngs_gpa = nan, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"odd\"]");
+        let e = err(&aniso, &[]);
+        assert!(e.contains("materials.odd.equivalent"), "{e}");
+    }
+
+    #[test]
+    fn issue20_item5_a_height_map_is_read_once_and_only_from_a_regular_file() {
+        let tmp_dir = tempfile::tempdir().unwrap();
+        let dir = tmp_dir.path().to_path_buf();
+        let heights = vec![0.0; 64 * 64];
+        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
+        let c = Config::parse_in(&text, &[], &dir).unwrap();
+        // Read when the config was checked; the cases share that one copy,
+        // and a file changed afterwards is not read again.
+        std::fs::remove_file(dir.join("h.npy")).unwrap();
+        let cases = c.cases().unwrap();
+        assert_eq!(cases.len(), 3);
+        let map = |i: usize| match &cases[i].1.surface {
+            Surface::Heightmap { heights, .. } => heights.clone(),
+            _ => panic!("not a height map"),
+        };
+        assert!(std::sync::Arc::ptr_eq(&map(0), &map(2)), "one copy");
+        // A FIFO (which would block a read) and a directory are refused at once.
+        let fifo = dir.join("pipe.npy");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let e = format!(
+                "{:#}",
+                Config::parse_in(&text.replace("h.npy", "pipe.npy"), &[], &dir).unwrap_err()
+            );
+            assert!(
+                e.contains("not a regular file") && e.contains("surfaces.rough.file"),
+                "{e}"
+            );
+        }
+        std::fs::create_dir(dir.join("d.npy")).unwrap();
+        let e = format!(
+            "{:#}",
+            Config::parse_in(&text.replace("h.npy", "d.npy"), &[], &dir).unwrap_err()
+        );
+        assert!(e.contains("not a regular file"), "{e}");
     }
 
     #[test]

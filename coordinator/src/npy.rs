@@ -32,19 +32,49 @@ pub fn write_fields(dir: &Path, fields: &Fields) -> Result<()> {
     Ok(())
 }
 
-/// Reads a float64 (or float32) `.npy` file: shape and values in C order.
-pub fn read_npy_f64(path: &Path) -> Result<(Vec<u64>, Vec<f64>)> {
-    let bytes = std::fs::read(path)?;
-    let npy = npyz::NpyFile::new(&bytes[..])?;
+/// Reads an `n x n` float64 (or float32) `.npy` file in C order. Only a
+/// regular file is opened (a FIFO would block, `/dev/zero` never end), and
+/// its header is checked against the grid before any data is read, so a
+/// wrong file costs no more than its header.
+pub fn read_grid_npy(path: &Path, n: usize) -> Result<Vec<f64>> {
+    let meta =
+        std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("{} is not a regular file", path.display());
+    }
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let npy = npyz::NpyFile::new(std::io::BufReader::new(file))
+        .with_context(|| format!("{} is not a .npy file", path.display()))?;
     let shape = npy.shape().to_vec();
+    if shape != [n as u64, n as u64] {
+        bail!(
+            "{} has shape {shape:?} but the grid is {n} x {n} (grid.points)",
+            path.display()
+        );
+    }
     if npy.order() != npyz::Order::C {
         bail!("Fortran-ordered arrays are not supported; save with numpy's default C order");
     }
-    let values: Vec<f64> = match npy.dtype() {
-        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 => {
-            npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
-        }
-        _ => npy.into_vec::<f64>()?,
+    let size = match npy.dtype() {
+        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float => t.size_field(),
+        other => bail!(
+            "{}: expected float64 or float32 values, got {}",
+            path.display(),
+            other.descr()
+        ),
     };
-    Ok((shape, values))
+    if meta.len() < (n * n) as u64 * size {
+        bail!(
+            "{} is {} bytes, too short for {n} x {n} values",
+            path.display(),
+            meta.len()
+        );
+    }
+    let values: Vec<f64> = if size == 4 {
+        npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
+    } else {
+        npy.into_vec::<f64>()?
+    };
+    Ok(values)
 }

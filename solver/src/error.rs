@@ -19,6 +19,13 @@ pub enum SolverError {
         /// Which zone touches the boundary.
         detail: String,
     },
+    /// The grid does not resolve the contact: it spans too few cells for a
+    /// contact radius (or anything derived from it) to mean something.
+    #[error("the contact is not resolved ({detail}); refine grid.spacing_um, or check the indenter radius and the load")]
+    ContactUnresolved {
+        /// What was found.
+        detail: String,
+    },
     /// The grid does not resolve the slip zone: no part of the contact's
     /// outline slips, so a = c and μa (Eq. 19) is undefined.
     #[error("the slip zone is not resolved ({detail}); refine grid.spacing_um (more cells across the contact)")]

@@ -159,6 +159,9 @@ pub fn calibrate_on_flat(s: &mut CaseScalars, flat: &CaseScalars, load: &Load) {
     s.mu_a = Some(mu_apparent(s, load.normal_force_n, k_e));
 }
 
+/// Smallest apparent contact or stick radius reported, in cells.
+pub const MIN_RESOLVED_CELLS: f64 = 2.0;
+
 /// The fields and scalars of a solved case: total displacements from all
 /// tractions, radii, shifts, forces and μa with the isotropic-equivalent K_E.
 /// `started` is when the solve began (for `seconds`).
@@ -211,6 +214,25 @@ pub(crate) fn reduce(
     } else {
         a
     };
+    // A zone a few cells across has no radius worth reporting: μa from
+    // it is grid noise (a stick zone of a few cells gave μa = 434, #20 item 8).
+    let min_radius = MIN_RESOLVED_CELLS * grid.dx.max(grid.dy);
+    if a < min_radius {
+        return Err(SolverError::ContactUnresolved {
+            detail: format!(
+                "a = {a:.3e} m spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m",
+                grid.dx
+            ),
+        });
+    }
+    if fnorm > 0.0 && c < min_radius {
+        return Err(SolverError::SlipUnresolved {
+            detail: format!(
+                "the stick zone, c = {c:.3e} m, spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m (F/μP = {} leaves almost no stick)",
+                grid.dx, spec.load.tangential_ratio
+            ),
+        });
+    }
     let dir = if fnorm > 0.0 {
         [force[0] / fnorm, force[1] / fnorm]
     } else {

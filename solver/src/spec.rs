@@ -240,6 +240,23 @@ impl CaseSpec {
         self.surface
             .validate(grid.n)
             .map_err(|e| within("surface", e))?;
+        // A contact a few cells across cannot be solved meaningfully (a
+        // 1e-300 m sphere gave δz = 4.6e296 m, #20 item 8). Hertz's radius
+        // with the isotropic-equivalent constants is the scale; patterns
+        // and anisotropy change it by tens of per cent, not by cells.
+        let a_hertz = (3.0 * load.normal_force_n * load.indenter_radius_m
+            / (4.0 * self.material.equivalent.plane_strain()))
+        .cbrt();
+        let min = crate::results::MIN_RESOLVED_CELLS * grid.dx;
+        if a_hertz < min {
+            return Err(SolverError::ContactUnresolved {
+                detail: format!(
+                    "the Hertz contact radius {a_hertz:.3e} m spans fewer than {} cells of {:.3e} m",
+                    crate::results::MIN_RESOLVED_CELLS,
+                    grid.dx
+                ),
+            });
+        }
         Ok(())
     }
 }

@@ -70,8 +70,8 @@ pub enum Surface {
     Heightmap {
         /// Cells per side.
         n: usize,
-        /// Heights, m.
-        heights: Vec<f64>,
+        /// Heights, m; shared, so that the cases of a sweep hold one copy.
+        heights: std::sync::Arc<Vec<f64>>,
     },
 }
 
@@ -392,7 +392,7 @@ mod tests {
             (
                 Surface::Heightmap {
                     n: 8,
-                    heights: vec![0.0; 64],
+                    heights: vec![0.0; 64].into(),
                 },
                 "heights",
             ),
@@ -402,7 +402,7 @@ mod tests {
                     heights: {
                         let mut v = vec![0.0; 256];
                         v[17] = f64::NAN;
-                        v
+                        v.into()
                     },
                 },
                 "heights",

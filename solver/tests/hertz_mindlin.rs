@@ -115,3 +115,23 @@ fn cattaneo_mindlin_uncoupled_then_coupled_on_table_1a() {
     assert!(rel(on.mu_a.unwrap(), 0.28571) < 0.03, "μa ≈ μ (coupled)");
     assert!(cache.builds() == 1, "one kernel for both cases");
 }
+
+#[test]
+fn issue20_item8_zones_the_grid_cannot_resolve_are_refused() {
+    // F = (1 − 1e-10) μP leaves a stick zone far below one cell (it gave
+    // μa = 434 before); a 1e-300 m sphere touches a single cell.
+    let mut spec = table_1a_fe(64, 5.0, false, 0.9999999999);
+    let e = solve_case(&spec, &mut KernelCache::new()).unwrap_err();
+    assert!(
+        matches!(e, solver::SolverError::SlipUnresolved { .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("stick zone"), "{e}");
+    spec.load.tangential_ratio = 0.6;
+    spec.load.indenter_radius_m = 1e-300;
+    let e = solve_case(&spec, &mut KernelCache::new()).unwrap_err();
+    assert!(
+        matches!(e, solver::SolverError::ContactUnresolved { .. }),
+        "{e}"
+    );
+}

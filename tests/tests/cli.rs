@@ -179,3 +179,26 @@ fn materials_lists_the_six_presets() {
         assert!(text.contains(m), "{m}");
     }
 }
+
+#[test]
+fn issue20_item11_out_that_is_a_file_is_named() {
+    let tmp_dir = temp_dir("outfile");
+    let dir = tmp_dir.path().to_path_buf();
+    std::fs::write(dir.join("c.toml"), SMALL).unwrap();
+    let file = dir.join("not-a-dir");
+    std::fs::write(&file, "x").unwrap();
+    let out = run(&[
+        "run",
+        &dir.join("c.toml").display().to_string(),
+        "--out",
+        &file.display().to_string(),
+        "--quiet",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&file.display().to_string()) && err.contains("not a directory"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}

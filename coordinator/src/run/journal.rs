@@ -73,6 +73,9 @@ impl Entry {
     }
 }
 
+/// How every journal's first line (its header) begins.
+const HEADER_START: &str = "{\"kind\":\"header\"";
+
 /// A journal line.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -145,6 +148,16 @@ impl Journal {
             }
             let text = std::fs::read(&path)
                 .with_context(|| format!("while reading {}", path.display()))?;
+            // A journal starts with our header line; anything else is not
+            // ours, even when it is one line without an end (which would
+            // otherwise pass for a torn line and be wiped).
+            let n = text.len().min(HEADER_START.len());
+            if text[..n] != HEADER_START.as_bytes()[..n] {
+                bail!(
+                    "--resume refused: {} is not an mpcontact journal (it does not start with {HEADER_START}); move it away or choose another --out",
+                    path.display()
+                );
+            }
             let mut good_len = 0usize;
             let mut lines = text.split_inclusive(|&b| b == b'\n').peekable();
             let mut first = true;
@@ -288,6 +301,27 @@ mod tests {
         assert_eq!(prev.entries[1], rec("b"));
         j.append(&Line::Case(Box::new(rec("c")))).unwrap();
         assert_eq!(Journal::read_entries(&p).unwrap().len(), 3);
+    }
+
+    #[test]
+    fn issue20_item11_a_one_line_file_that_is_not_ours_is_not_wiped() {
+        let tmp_dir = tmp("foreign");
+        let d = tmp_dir.path().to_path_buf();
+        let p = d.join(JOURNAL_FILE);
+        for foreign in ["my notes, no newline", "{\"kind\":\"case\"}\n", "x"] {
+            std::fs::write(&p, foreign).unwrap();
+            let e = format!("{:#}", Journal::open(&d, "r", "cfg", true).err().unwrap());
+            assert!(e.contains("not an mpcontact journal"), "{e}");
+            assert_eq!(
+                std::fs::read_to_string(&p).unwrap(),
+                foreign,
+                "left as it was"
+            );
+        }
+        // A header torn while being written is ours: resumed afresh.
+        std::fs::write(&p, "{\"kind\":\"hea").unwrap();
+        let (_, prev) = Journal::open(&d, "r", "cfg", true).unwrap();
+        assert!(prev.torn_tail && prev.entries.is_empty());
     }
 
     #[test]

@@ -1,48 +1,77 @@
-//! The exclusive claim of a sweep on its output directory
-//! (`.mpcontact.lock`, holding the coordinator's pid). Owns only that file.
+//! The exclusive claim of a sweep on its output directory: an advisory lock
+//! (`flock`) on the directory itself, held for the life of the run. Owns only
+//! that lock.
+//!
+//! The kernel releases the lock when its holder exits, however it exits
+//! (SIGKILL included), so there is no stale lock to judge and no lock file to
+//! leave behind. The pid file of older builds (`.mpcontact.lock`) raced: two
+//! runs that both found a dead pid in it both went on (2 of 20 trials).
 
 use anyhow::Context;
-use std::path::{Path, PathBuf};
+use std::fs::{File, TryLockError};
+use std::path::Path;
+
+/// The lock file of builds before the directory lock; removed when found.
+const OLD_LOCK_FILE: &str = ".mpcontact.lock";
 
 /// An exclusive claim on an output directory for the life of a run.
-pub struct DirLock(PathBuf);
+pub struct DirLock {
+    /// The open directory; closing it releases the lock.
+    _dir: File,
+}
 
 impl DirLock {
-    /// Take the lock of `out_dir`; refused while the pid in an existing lock
-    /// file is a running process (a stale lock is replaced).
+    /// Take the lock of `out_dir` (an existing directory); refused while
+    /// another process holds it.
     pub fn take(out_dir: &Path) -> anyhow::Result<DirLock> {
-        let path = out_dir.join(".mpcontact.lock");
-        for _ in 0..2 {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&path)
-            {
-                Ok(mut f) => {
-                    use std::io::Write;
-                    writeln!(f, "{}", std::process::id())?;
-                    return Ok(DirLock(path));
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let pid = std::fs::read_to_string(&path).unwrap_or_default();
-                    let pid = pid.trim();
-                    if !pid.is_empty() && Path::new(&format!("/proc/{pid}")).exists() {
-                        anyhow::bail!(
-                            "{} is in use by a running sweep (pid {pid})",
-                            out_dir.display()
-                        );
-                    }
-                    let _ = std::fs::remove_file(&path);
-                }
-                Err(e) => return Err(e).context(format!("while locking {}", out_dir.display())),
+        let dir = File::open(out_dir)
+            .with_context(|| format!("cannot open the output directory {}", out_dir.display()))?;
+        match dir.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => anyhow::bail!(
+                "{} is in use by a running sweep (another mpcontact run holds its lock)",
+                out_dir.display()
+            ),
+            Err(TryLockError::Error(e)) => {
+                return Err(e).with_context(|| format!("cannot lock {}", out_dir.display()))
             }
         }
-        anyhow::bail!("cannot lock {}", out_dir.display())
+        let _ = std::fs::remove_file(out_dir.join(OLD_LOCK_FILE));
+        Ok(DirLock { _dir: dir })
     }
 }
 
-impl Drop for DirLock {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn issue20_item10_only_one_of_two_simultaneous_runs_gets_the_directory() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        for trial in 0..50 {
+            // A pid file of an older build naming a dead process, as SIGKILL left it.
+            std::fs::write(dir.join(OLD_LOCK_FILE), "4194304\n").unwrap();
+            let barrier = std::sync::Barrier::new(2);
+            let (a, b) = std::thread::scope(|s| {
+                let take = || {
+                    barrier.wait();
+                    DirLock::take(dir)
+                };
+                let a = s.spawn(take);
+                let b = s.spawn(take);
+                (a.join().unwrap(), b.join().unwrap())
+            });
+            assert!(
+                a.is_ok() != b.is_ok(),
+                "trial {trial}: exactly one run may hold the directory"
+            );
+            let e = format!("{:#}", a.err().or(b.err()).unwrap());
+            assert!(e.contains("in use by a running sweep"), "{e}");
+        }
+        // Released with its holder, and no lock file is left behind.
+        drop(DirLock::take(dir).unwrap());
+        let _again = DirLock::take(dir).unwrap();
+        assert!(!dir.join(OLD_LOCK_FILE).exists());
     }
 }

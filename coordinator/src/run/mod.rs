@@ -71,8 +71,18 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
-    std::fs::create_dir_all(&args.out_dir)
-        .with_context(|| format!("while creating {}", args.out_dir.display()))?;
+    if args.out_dir.exists() && !args.out_dir.is_dir() {
+        anyhow::bail!(
+            "--out {}: exists and is not a directory",
+            args.out_dir.display()
+        );
+    }
+    std::fs::create_dir_all(&args.out_dir).with_context(|| {
+        format!(
+            "cannot create the output directory {}",
+            args.out_dir.display()
+        )
+    })?;
     let _lock = lock::DirLock::take(&args.out_dir)?;
     let run_id = new_run_id();
     let plan = Plan::new(args.config.cases()?);

@@ -81,8 +81,15 @@ impl<'a> Supervisor<'a> {
         self.next_index += 1;
         self.spawns_left = self.spawns_left.saturating_sub(1);
         let log_dir = self.args.out_dir.join("worker-logs");
-        std::fs::create_dir_all(&log_dir)?;
-        let log = std::fs::File::create(log_dir.join(format!("worker-{k}.log")))?;
+        std::fs::create_dir_all(&log_dir).with_context(|| {
+            format!(
+                "cannot create the worker log directory {}",
+                log_dir.display()
+            )
+        })?;
+        let log_path = log_dir.join(format!("worker-{k}.log"));
+        let log = std::fs::File::create(&log_path)
+            .with_context(|| format!("cannot create {}", log_path.display()))?;
         let child = Command::new(self.args.exe)
             .args([
                 "worker",
