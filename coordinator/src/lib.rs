@@ -5,6 +5,7 @@
 //! the files they write. Physics lives in `solver`; messages in `protocol`.
 //! A case is named by one typed key (`case::CaseKey`) everywhere.
 
+pub mod atomic;
 pub mod case;
 pub mod config;
 pub mod maps;

@@ -147,6 +147,18 @@ fn materials_table() -> String {
     s
 }
 
+/// The program workers are started from: this very one. Linux's
+/// `/proc/self/exe` names the running image even after the file at its path
+/// was rebuilt or removed, so a replacement worker never runs another build
+/// (#20 item 12); elsewhere, the path this program was started from.
+fn worker_exe() -> Result<PathBuf> {
+    let this = std::path::Path::new("/proc/self/exe");
+    if this.exists() {
+        return Ok(this.to_path_buf());
+    }
+    std::env::current_exe().context("cannot locate the mpcontact executable")
+}
+
 fn real_main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Run {
@@ -175,7 +187,7 @@ fn real_main() -> Result<()> {
                 resume,
                 quiet,
                 save_fields,
-                exe: std::env::current_exe().context("cannot locate the mpcontact executable")?,
+                exe: worker_exe()?,
             };
             coordinator::run::run_sweep(&args)?;
             Ok(())

@@ -3,7 +3,7 @@
 //! stick/slip map, axes in units of the contact radius, with a colour bar.
 //! Drawing only; the fields come from `solver::Fields`.
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use solver::{CaseScalars, Fields};
 use std::path::Path;
@@ -185,16 +185,10 @@ pub fn write_maps(
     let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
     for m in &maps {
         let path = dir.join(m.file);
-        draw_map(
-            &path,
-            &format!("{title}: {}", m.label),
-            m,
-            n,
-            spacing_m,
-            a,
-            extent,
-        )
-        .with_context(|| format!("while drawing {}", path.display()))?;
+        let label = format!("{title}: {}", m.label);
+        crate::atomic::replace_with(&path, |tmp| {
+            draw_map(tmp, &label, m, n, spacing_m, a, extent)
+        })?;
     }
     Ok(())
 }

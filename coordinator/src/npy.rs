@@ -11,16 +11,17 @@ use solver::Fields;
 
 /// Writes one `n x n` field as a 2-D float64 `.npy` (rows = y, columns = x).
 pub fn write_npy(path: &Path, n: usize, data: &[f64]) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut w = npyz::WriteOptions::new()
-        .default_dtype()
-        .shape(&[n as u64, n as u64])
-        .writer(BufWriter::new(file))
-        .begin_nd()?;
-    w.extend(data.iter().copied())?;
-    w.finish()?;
-    Ok(())
+    crate::atomic::replace_with(path, |tmp| {
+        let file = std::fs::File::create(tmp)?;
+        let mut w = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(&[n as u64, n as u64])
+            .writer(BufWriter::new(file))
+            .begin_nd()?;
+        w.extend(data.iter().copied())?;
+        w.finish()?;
+        Ok(())
+    })
 }
 
 /// Writes every field of a case into `dir` as `<name>.npy`.

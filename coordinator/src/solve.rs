@@ -78,8 +78,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         spec: &spec,
     };
     let path = args.out.join("case.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crate::atomic::write(&path, serde_json::to_string_pretty(&json)?.as_bytes())?;
     write_fields(args.out, &out.fields)?;
     // The numbers are written first; a picture that cannot be drawn (e.g. no
     // system font) is a warning, not a lost result.

@@ -723,3 +723,59 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
     assert!(s["rejected_messages"].as_u64().unwrap() >= 4, "{s}");
     assert_eq!(shm_leftovers("i"), Vec::<String>::new());
 }
+
+/// #20 item 12: a replacement worker is started from the running program,
+/// not from whatever file is now at its path (a rebuild, or an impostor).
+#[test]
+fn issue20_item12_a_replacement_worker_runs_the_same_build() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("rebuilt");
+    std::fs::write(
+        dir.join("sweep.toml"),
+        format!("{CONFIG}\n[run]\ncase_timeout_s = 2\n"),
+    )
+    .unwrap();
+    let copy = dir.join("mpcontact-copy");
+    std::fs::copy(EXE, &copy).unwrap();
+    let marker = dir.join("hang.marker");
+    let impostor_ran = dir.join("impostor-ran");
+    let template = sweep_cmd(&dir, "out", 2, "r");
+    let mut cmd = Command::new(&copy);
+    cmd.args(template.get_args());
+    for (k, v) in template.get_envs() {
+        if let Some(v) = v {
+            cmd.env(k, v);
+        }
+    }
+    cmd.env(HANG_CASE_ENV, "Cu/flat/045.0")
+        .env(HANG_MARKER_ENV, &marker);
+    let (copy2, ran) = (copy.clone(), impostor_ran.clone());
+    let (status, lines) = run_timed(cmd, move |_| {
+        let t = std::time::Instant::now();
+        while !marker.exists() {
+            assert!(t.elapsed().as_secs() < 120, "the hang hook never fired");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // "Rebuild" the binary while the sweep runs: the file at its path
+        // is now another program.
+        std::fs::remove_file(&copy2).unwrap();
+        std::fs::write(
+            &copy2,
+            format!("#!/bin/sh\ntouch '{}'\nexit 3\n", ran.display()),
+        )
+        .unwrap();
+        std::fs::set_permissions(&copy2, std::fs::Permissions::from_mode(0o755)).unwrap();
+    });
+    let text: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert!(status.success(), "{}", text.join("\n"));
+    assert!(
+        text.iter().any(|l| l.contains("hung:")),
+        "no replacement was needed:\n{}",
+        text.join("\n")
+    );
+    assert!(
+        !impostor_ran.exists(),
+        "a replacement ran the file now at the binary's path"
+    );
+    assert_every_case_once(&dir.join("out"));
+}

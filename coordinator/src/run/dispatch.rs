@@ -467,7 +467,14 @@ impl<'a> Dispatch<'a> {
                 }
             }
             if rec.plan().remaining() > 0 && sup.may_spawn() {
-                self.spawn(sup)?;
+                // A worker that cannot be replaced is no reason to stop the
+                // healthy ones (#20 item 12): go on with fewer.
+                if let Err(e) = self.spawn(sup) {
+                    let live = self.peers.values().filter(|p| !p.dead).count();
+                    self.note(&format!(
+                        "cannot start a replacement for worker {k} ({e:#}); going on with {live} worker(s)"
+                    ));
+                }
             }
         }
         if rec.plan().remaining() > 0 && self.peers.values().all(|p| p.dead) {

@@ -124,8 +124,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
             save_fields: args.save_fields || args.config.output.save_fields,
             progress: &progress,
         });
-        let outcome = (0..workers)
-            .try_for_each(|_| dispatch.spawn(&mut supervisor))
+        let outcome = start_workers(&mut dispatch, &mut supervisor, workers, &progress)
             .and_then(|()| dispatch.serve(&exchange, &mut supervisor, &mut recorder));
         let stats = dispatch.finish(&exchange);
         supervisor.stop_all();
@@ -167,6 +166,34 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     Ok(summary)
 }
 
+/// Starts `workers` worker processes; goes on with those that started
+/// (saying so) unless none did.
+fn start_workers(
+    dispatch: &mut dispatch::Dispatch,
+    supervisor: &mut supervise::Supervisor,
+    workers: usize,
+    progress: &progress::Progress,
+) -> anyhow::Result<()> {
+    let mut started = 0;
+    let mut last_error = None;
+    for _ in 0..workers {
+        match dispatch.spawn(supervisor) {
+            Ok(()) => started += 1,
+            Err(e) => last_error = Some(e),
+        }
+    }
+    match last_error {
+        Some(e) if started == 0 => Err(e),
+        Some(e) => {
+            progress.note(&format!(
+                "only {started} of {workers} workers could be started ({e:#}); going on with {started}"
+            ));
+            Ok(())
+        }
+        None => Ok(()),
+    }
+}
+
 fn write_outputs(
     args: &RunArgs,
     recorder: &record::Recorder,
@@ -176,10 +203,7 @@ fn write_outputs(
     let dir = &args.out_dir;
     let (cases, outcomes) = recorder.results();
     let rows = output::calibrate(cases, outcomes);
-    let write = |name: &str, text: String| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).with_context(|| format!("while writing {}", p.display()))
-    };
+    let write = |name: &str, text: String| crate::atomic::write(&dir.join(name), text.as_bytes());
     write("results.csv", output::results_csv(&rows))?;
     write("curves.csv", output::curves_csv(&rows))?;
     let curves = output::curves(&rows);

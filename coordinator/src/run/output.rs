@@ -224,18 +224,16 @@ pub fn plot_curves(path: &Path, curves: &BTreeMap<String, Vec<(f64, f64)>>) -> a
         root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
         Ok(())
     }
-    if is_svg {
-        draw(
-            SVGBackend::new(path, (900, 600)).into_drawing_area(),
-            curves,
-        )
-    } else {
-        draw(
-            BitMapBackend::new(path, (900, 600)).into_drawing_area(),
-            curves,
-        )
-    }
-    .with_context(|| format!("while drawing {}", path.display()))
+    crate::atomic::replace_with(path, |tmp| {
+        if is_svg {
+            draw(SVGBackend::new(tmp, (900, 600)).into_drawing_area(), curves)
+        } else {
+            draw(
+                BitMapBackend::new(tmp, (900, 600)).into_drawing_area(),
+                curves,
+            )
+        }
+    })
 }
 
 /// Directory of a case's fields: `fields/<material>/<surface>/<angle>`
