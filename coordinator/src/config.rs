@@ -437,6 +437,64 @@ fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
     Ok(())
 }
 
+/// Longest line of an error message echoed whole: a parse error quotes the
+/// offending line, and a 10 MB key made a 31 MB message (#20 item 7).
+const MAX_ECHO: usize = 200;
+
+/// `msg` with every line longer than [`MAX_ECHO`] characters cut.
+fn shorten(msg: &str) -> String {
+    msg.lines()
+        .map(|l| match l.char_indices().nth(MAX_ECHO) {
+            Some((cut, _)) => format!(
+                "{}… ({} more characters)",
+                &l[..cut],
+                l[cut..].chars().count()
+            ),
+            None => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Deepest nesting a config may use: the deepest key of ours is
+/// `materials.NAME.isotropic.youngs_gpa`; the TOML parser gives up on deep
+/// nesting with "recursion limit" and no line (#20 item 7).
+const MAX_NESTING: usize = 16;
+
+/// Refuses a line whose key or value nests deeper than [`MAX_NESTING`]
+/// (dots of a dotted key, brackets and braces), naming the line.
+fn check_nesting(text: &str) -> Result<()> {
+    for (i, line) in text.lines().enumerate() {
+        let (mut depth, mut deepest, mut dots) = (0usize, 0usize, 0usize);
+        let mut quote: Option<char> = None;
+        let mut seen_eq = false;
+        for c in line.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '"' | '\'') => quote = Some(c),
+                (None, '#') => break,
+                (None, '=') => seen_eq = true,
+                (None, '.') if !seen_eq => dots += 1,
+                (None, '[' | '{') => {
+                    depth += 1;
+                    deepest = deepest.max(depth);
+                }
+                (None, ']' | '}') => depth = depth.saturating_sub(1),
+                _ => {}
+            }
+        }
+        if dots + deepest > MAX_NESTING {
+            bail!(
+                "line {}: keys and values nest {} levels deep; a config needs at most {MAX_NESTING}",
+                i + 1,
+                dots + deepest
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The config key of a solver parameter that is not in a material or
 /// surface table (the solver's errors name its parameters).
 fn config_key(param: &str) -> String {
@@ -504,14 +562,18 @@ impl Config {
 
     /// Parses config text and applies `--set` overrides; relative paths start at `base`.
     pub fn parse_in(text: &str, sets: &[String], base: &Path) -> Result<Config> {
+        check_nesting(text)?;
         // First pass on the text itself: errors carry line and column.
-        let mut cfg: Config = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        let mut cfg: Config =
+            toml::from_str(text).map_err(|e| anyhow!("{}", shorten(&e.to_string())))?;
         cfg.base_dir = base.to_path_buf();
         if sets.is_empty() {
             cfg.check()?;
             return Ok(cfg);
         }
-        let mut table: toml::Table = text.parse().map_err(|e| anyhow!("{e}"))?;
+        let mut table: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| anyhow!("{}", shorten(&e.to_string())))?;
         for s in sets {
             apply_set(&mut table, s)?;
         }
@@ -1045,6 +1107,25 @@ angles_deg = { start = 0, stop = 90, step = 45 }
             Config::parse_in(&text.replace("h.npy", "d.npy"), &[], &dir).unwrap_err()
         );
         assert!(e.contains("not a regular file"), "{e}");
+    }
+
+    #[test]
+    fn issue20_item7_long_lines_are_cut_and_deep_keys_named() {
+        let key = "k".repeat(10_000_000);
+        let e = err(&format!("{BASE}\n{key} = 1\n"), &[]);
+        assert!(e.len() < 2_000, "{} characters", e.len());
+        assert!(e.contains("more characters"), "{}", &e[..e.len().min(400)]);
+        let deep = vec!["a"; 100].join(".");
+        let e = err(&format!("{deep} = 1\n{BASE}"), &[]);
+        assert!(e.contains("line 1") && e.contains("nest"), "{e}");
+        let nested = format!("x = {}1{}\n", "[".repeat(100), "]".repeat(100));
+        let e = err(&format!("{nested}{BASE}"), &[]);
+        assert!(e.contains("line 1"), "{e}");
+        // Our own deepest keys and quoted names with dots pass.
+        let ok = format!(
+            "{BASE}\n[materials.\"a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r\"]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\n"
+        );
+        Config::parse(&ok, &[]).unwrap();
     }
 
     #[test]
