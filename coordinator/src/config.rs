@@ -326,16 +326,15 @@ pub struct OutputCfg {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunCfg {
-    /// Floor of the per-case deadline, s. A case in flight longer than
-    /// max(this, [`HUNG_FACTOR`] × the longest case recorded so far) is
-    /// taken from its worker (killed when the coordinator started it) and
-    /// dispatched again.
+    /// Longest silence, s, of a worker with a case in flight: workers beat
+    /// a few times a second while they compute (kernel builds and solver
+    /// iterations included), so only a worker that says nothing for this
+    /// long is hung; its case is taken from it (the worker is killed when
+    /// this coordinator started it) and dispatched again. However long a
+    /// case computes, it is never cut short.
     #[serde(default = "default_case_timeout")]
     pub case_timeout_s: f64,
 }
-
-/// Multiple of the longest observed case time after which a case is hung.
-pub const HUNG_FACTOR: f64 = 10.0;
 
 fn default_case_timeout() -> f64 {
     60.0

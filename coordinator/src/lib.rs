@@ -9,6 +9,7 @@ pub mod atomic;
 pub mod case;
 pub mod config;
 pub mod maps;
+pub mod memory;
 pub mod npy;
 pub mod run;
 pub mod solve;

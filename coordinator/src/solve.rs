@@ -48,6 +48,12 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let spec = config.spec(material, surface, angle)?;
     spec.validate()
         .map_err(|e| config.explain(e, material, surface))?;
+    crate::memory::check_fits(
+        "this case",
+        crate::memory::worker_bytes(spec.grid.n, 1),
+        1,
+        crate::memory::available_bytes(),
+    )?;
     let mut cache = worker::kernel_store::FileStore::cache();
     let out =
         solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;

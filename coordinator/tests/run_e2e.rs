@@ -779,3 +779,46 @@ fn issue20_item12_a_replacement_worker_runs_the_same_build() {
     );
     assert_every_case_once(&dir.join("out"));
 }
+
+/// #20 item 4: a case that computes far longer than `run.case_timeout_s`
+/// is not taken for a hang: the worker beats while it computes. (The old
+/// deadline, max(timeout, 10 × longest case so far), killed the first long
+/// case twice and journalled it failed.)
+#[test]
+fn issue20_item4_a_long_computation_is_not_a_hang() {
+    let dir = scratch("long");
+    let config = r#"
+[grid]
+points = 512
+spacing_um = 12.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["flat"]
+angles_deg = [0.0, 90.0]
+
+[run]
+case_timeout_s = 0.5
+"#;
+    std::fs::write(dir.join("sweep.toml"), config).unwrap();
+    let out = sweep_cmd(&dir, "out", 1, "l").output().unwrap();
+    check_ok(&out, "sweep of long cases");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("hung:"), "{err}");
+    let rows = read_csv(&dir.join("out/results.csv"));
+    let head = &rows[0];
+    let col = |name: &str| head.iter().position(|h| h == name).unwrap();
+    for row in &rows[1..] {
+        assert_eq!(row[col("status")], "ok", "{row:?}");
+        let seconds: f64 = row[col("seconds")].parse().unwrap();
+        assert!(seconds > 1.0, "the case was not long: {seconds} s");
+    }
+}

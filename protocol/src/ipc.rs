@@ -98,6 +98,29 @@ pub fn ipc_root_dir() -> Result<PathBuf, IpcSetupError> {
     Ok(dir)
 }
 
+/// How often at most a worker beats while it computes (a few times a
+/// second: enough to tell a long computation from a hang within a second).
+pub const HEARTBEAT_INTERVAL: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// The file worker `worker_index` of run `run_id` beats in while it computes,
+/// in the per-user IPC root (0700): 8 bytes, the Unix time in ns of its last
+/// sign of life (little endian), rewritten in place.
+pub fn heartbeat_path(run_id: &str, worker_index: usize) -> Result<PathBuf, IpcSetupError> {
+    Ok(ipc_root_dir()?.join(format!("{run_id}-worker-{worker_index}.beat")))
+}
+
+/// Writes a beat (`unix_ns`) into an open heartbeat file.
+pub fn write_heartbeat(file: &std::fs::File, unix_ns: u64) -> std::io::Result<()> {
+    use std::os::unix::fs::FileExt;
+    file.write_all_at(&unix_ns.to_le_bytes(), 0)
+}
+
+/// The last beat in a heartbeat file (Unix time, ns), if it holds one.
+pub fn read_heartbeat(path: &std::path::Path) -> Option<u64> {
+    let bytes = std::fs::read(path).ok()?;
+    Some(u64::from_le_bytes(bytes.get(..8)?.try_into().ok()?))
+}
+
 /// The iceoryx2 configuration shared by every process of every run: fixed
 /// prefix [`IPC_PREFIX`] (or `$MPCONTACT_IPC_PREFIX`), per-user root directory
 /// [`ipc_root_dir`]. Never reads iceoryx2 config files.

@@ -52,6 +52,7 @@ pub mod multilevel;
 pub mod normal;
 pub mod operator;
 pub mod presets;
+mod progress;
 mod results;
 mod spec;
 mod surface;
@@ -64,6 +65,7 @@ pub use grid::Grid;
 pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
+pub use progress::{set_tick_hook, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
     APPARENT_RADIUS_DEFINITION, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,

@@ -149,6 +149,7 @@ pub fn coarse_levels(grid: Grid, zz_table: &[f64]) -> Vec<CoarseLevel> {
     let mut table = zz_table.to_vec();
     let mut g = grid;
     while g.n.is_multiple_of(2) && g.n / 2 >= MIN_COARSE_N {
+        crate::progress::tick();
         table = coarse_table(&table, g.n);
         g = Grid {
             n: g.n / 2,

@@ -244,6 +244,7 @@ impl Operator {
         let mut blocks = vec![[[0.0; 3]; 3]; m];
         let mut row = vec![0.0; m];
         for iy in 0..m {
+            crate::progress::tick();
             kernel_row(grid, iy, &cell, &mut blocks);
             for (&(i, j), out) in STORED.iter().zip(full.iter_mut()) {
                 for (r, b) in row.iter_mut().zip(&blocks) {
@@ -352,6 +353,7 @@ impl Operator {
         let source = |i: usize| if i < nw { i } else { i + m - mw };
         let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(STORED.len());
         for &(i, j) in &STORED {
+            crate::progress::tick();
             self.spectra.component(i, j).write_complex(&mut spec);
             self.fft.inverse_full(&mut spec, &mut table);
             let mut w = vec![Complex64::default(); fft.spectrum_len()];

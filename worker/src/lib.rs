@@ -13,6 +13,7 @@
 //! The case key is the coordinator's type (`K`): the worker returns it
 //! unchanged with the result and never looks inside it.
 
+pub mod heartbeat;
 pub mod kernel_store;
 
 use std::collections::HashSet;
@@ -104,6 +105,13 @@ enum Answer<K> {
 /// the coordinator's case key type.
 pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
     let w = attach(run_id, worker_index)?;
+    // The solver's loops beat for this worker while it computes.
+    let heartbeat = std::rc::Rc::new(std::cell::RefCell::new(heartbeat::Heartbeat::open(
+        run_id,
+        worker_index,
+    )?));
+    let ticking = heartbeat.clone();
+    solver::set_tick_hook(Some(Box::new(move || ticking.borrow_mut().tick())));
     let mut cache = kernel_store::FileStore::cache();
     let mut keys: HashSet<KernelKey> = HashSet::new();
     let mut next: WorkerMessage<K> = ToCoord::Ready(Ready {
@@ -128,6 +136,7 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
             }
             Some(ToWorker::Case(case)) => {
                 drop(pending);
+                heartbeat.borrow_mut().beat();
                 #[cfg(feature = "fault-injection")]
                 fault_injection::before_solve(&case.key.to_string());
                 let (msg, fields) = solve_one(&case, worker_index, &mut cache, &mut keys);

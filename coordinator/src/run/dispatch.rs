@@ -114,7 +114,7 @@ impl<'a> Dispatch<'a> {
         let mut last_tick = Instant::now();
         let mut finished_at: Option<Instant> = None;
         ex.wait_loop(TICK, || {
-            self.drain(ex, sup, rec)?;
+            self.drain(ex, rec)?;
             if last_tick.elapsed() >= TICK {
                 last_tick = Instant::now();
                 self.check_liveness(ex, sup, rec)?;
@@ -139,12 +139,7 @@ impl<'a> Dispatch<'a> {
     }
 
     /// Take every waiting request: act on it, then answer it (or hold it).
-    fn drain(
-        &mut self,
-        ex: &Exchange,
-        sup: &mut Supervisor,
-        rec: &mut Recorder,
-    ) -> anyhow::Result<()> {
+    fn drain(&mut self, ex: &Exchange, rec: &mut Recorder) -> anyhow::Result<()> {
         let mut answered = false;
         while let Some(request) = ex.receive()? {
             let d = match ex.decode(&request) {
@@ -179,9 +174,9 @@ impl<'a> Dispatch<'a> {
             match body {
                 ToCoord::Result(h) => {
                     let arrived = (request.received_ns(), request.payload_len());
-                    self.on_result(sup, rec, worker, h, d.field_bytes, arrived)?;
+                    self.on_result(rec, worker, h, d.field_bytes, arrived)?;
                 }
-                ToCoord::Failed(f) => self.on_failure(sup, rec, worker, f)?,
+                ToCoord::Failed(f) => self.on_failure(rec, worker, f)?,
                 ToCoord::Ready(_) | ToCoord::Heartbeat { .. } => {}
             }
             // Whatever this worker had in flight and did not report goes back.
@@ -200,21 +195,19 @@ impl<'a> Dispatch<'a> {
 
     fn on_failure(
         &mut self,
-        sup: &mut Supervisor,
         rec: &mut Recorder,
         worker: usize,
         f: Failure<CaseKey>,
     ) -> anyhow::Result<()> {
         if let Some(i) = rec.plan().index_of(&f.key) {
             let outcome = Outcome::failed(f.error, worker, f.solve_seconds, f.kernel_builds);
-            self.record(sup, rec, i, worker, outcome)?;
+            self.record(rec, i, worker, outcome)?;
         }
         Ok(())
     }
 
     fn on_result(
         &mut self,
-        sup: &mut Supervisor,
         rec: &mut Recorder,
         worker: usize,
         h: ResultHeader<CaseKey, WireScalars>,
@@ -253,7 +246,7 @@ impl<'a> Dispatch<'a> {
             if mine && (deterministic || case.attempts >= MAX_ATTEMPTS) {
                 let error = format!("invalid result: {e}");
                 let outcome = Outcome::failed(error, worker, h.solve_seconds, h.kernel_builds);
-                self.record(sup, rec, i, worker, outcome)?;
+                self.record(rec, i, worker, outcome)?;
             } else if mine {
                 rec.requeue(i);
             }
@@ -276,7 +269,7 @@ impl<'a> Dispatch<'a> {
             kernel_builds: h.kernel_builds,
             scalars: Some(h.scalars.0),
         };
-        self.record(sup, rec, i, worker, outcome)?;
+        self.record(rec, i, worker, outcome)?;
         self.ipc
             .add(n, payload_len, h.sent_unix_ns, received_ns, unix_ns());
         Ok(())
@@ -285,7 +278,6 @@ impl<'a> Dispatch<'a> {
     /// Record case `i` (see [`Recorder::record`]) and report it.
     fn record(
         &mut self,
-        sup: &mut Supervisor,
         rec: &mut Recorder,
         i: usize,
         worker: usize,
@@ -294,9 +286,6 @@ impl<'a> Dispatch<'a> {
         let Some(done) = rec.record(i, outcome)? else {
             return Ok(());
         };
-        if let Some(took) = done.in_flight_for {
-            sup.case_finished(took);
-        }
         let r = &done.outcome;
         if let Some(peer) = self.peers.get_mut(&worker) {
             peer.stats.cases += 1;
@@ -422,12 +411,17 @@ impl<'a> Dispatch<'a> {
             match sup.verdict(k, peer.registered, in_flight_for, &survey) {
                 Verdict::Alive => {}
                 Verdict::Gone => died.push(k),
-                Verdict::Hung { took, deadline } => {
+                Verdict::Hung {
+                    took,
+                    silent,
+                    deadline,
+                } => {
                     let i = peer.in_flight.unwrap_or_default();
                     self.note(&format!(
-                        "worker {k} hung: {} in flight for {:.1} s (deadline {:.1} s); {}",
+                        "worker {k} hung: {} in flight for {:.1} s, no sign of life for {:.1} s (run.case_timeout_s = {:.1} s); {}",
                         rec.plan().cases[i].key,
                         took.as_secs_f64(),
+                        silent.as_secs_f64(),
                         deadline.as_secs_f64(),
                         if sup.owns(k) {
                             "killing it"
@@ -460,7 +454,7 @@ impl<'a> Dispatch<'a> {
                         let error =
                             format!("its worker died or hung on it {} times", case.attempts);
                         let outcome = Outcome::failed(error, k, 0.0, 0);
-                        self.record(sup, rec, i, k, outcome)?;
+                        self.record(rec, i, k, outcome)?;
                     } else {
                         rec.requeue(i);
                     }

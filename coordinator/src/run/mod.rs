@@ -87,6 +87,13 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let run_id = new_run_id();
     let plan = Plan::new(args.config.cases()?);
     anyhow::ensure!(!plan.cases.is_empty(), "the sweep has no cases");
+    let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
+    crate::memory::check_fits(
+        "the sweep",
+        crate::memory::worker_bytes(args.config.grid.points, kernels.len()),
+        args.workers,
+        crate::memory::available_bytes(),
+    )?;
     let raw = args.config.to_toml();
     let (mut recorder, resumed) =
         record::Recorder::open(plan, &args.out_dir, &run_id, &raw, args.resume)?;

@@ -4,7 +4,6 @@
 //! writes only the journal (through `journal`).
 
 use std::path::Path;
-use std::time::Duration;
 
 use super::journal::{Entry, Journal, Line, Outcome};
 use super::plan::{CaseState, Plan, PlannedCase};
@@ -28,8 +27,6 @@ pub struct Resumed {
 
 /// A case that was just recorded.
 pub struct Recorded {
-    /// How long it was in flight, when it was.
-    pub in_flight_for: Option<Duration>,
     /// What was journalled (the status may have become `failed` when the
     /// result could not be written as JSON).
     pub outcome: Outcome,
@@ -121,14 +118,10 @@ impl Recorder {
             &case.key,
             outcome.clone(),
         ))))?;
-        let in_flight_for = self.plan.in_flight(i).map(|(_, took)| took);
         self.plan.mark_done(i);
         self.outcomes[i] = Some(outcome.clone());
         self.recorded += 1;
-        Ok(Some(Recorded {
-            in_flight_for,
-            outcome,
-        }))
+        Ok(Some(Recorded { outcome }))
     }
 
     /// Every case with its outcome (None while unrecorded), in plan order.
@@ -183,8 +176,7 @@ mod tests {
         let (mut rec, resumed) = Recorder::open(plan(), &d, "r1", "cfg", false).unwrap();
         assert_eq!(resumed.cases, 0);
         rec.dispatched(1, 0);
-        let first = rec.record(1, ok(0)).unwrap().unwrap();
-        assert!(first.in_flight_for.is_some());
+        assert!(rec.record(1, ok(0)).unwrap().is_some());
         assert!(rec.record(1, ok(7)).unwrap().is_none(), "recorded twice");
         assert_eq!(rec.recorded(), 1);
         drop(rec);

@@ -1,12 +1,14 @@
 //! Worker processes: starting the ones this coordinator owns (logs in
 //! `worker-logs/`), watching them, and the verdict on any worker's liveness
-//! (process exited, node gone, case past its deadline). Must not touch IPC
-//! messages, the plan or the journal: it judges, `dispatch` acts.
+//! (process exited, node gone, silent past `run.case_timeout_s` while a case
+//! is in flight — workers beat while they compute, so a long computation is
+//! never a hang). Must not touch IPC messages, the plan or the journal: it
+//! judges, `dispatch` acts.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use anyhow::Context;
 use iceoryx2::node::NodeView;
@@ -25,7 +27,7 @@ pub struct SuperviseArgs<'a> {
     /// Workers of the run; replacements are limited to `2 × workers + 2`
     /// starts in all.
     pub workers: usize,
-    /// Floor of the per-case deadline (`run.case_timeout_s`).
+    /// Longest silence of a worker with a case in flight (`run.case_timeout_s`).
     pub case_timeout: Duration,
 }
 
@@ -35,8 +37,6 @@ pub struct Supervisor<'a> {
     children: BTreeMap<usize, Child>,
     next_index: usize,
     spawns_left: usize,
-    /// Longest dispatch → record time of a case seen so far.
-    longest_case: Duration,
 }
 
 /// Which worker nodes of the system were alive at one listing.
@@ -51,11 +51,14 @@ pub struct NodeSurvey {
 pub enum Verdict {
     /// Nothing wrong seen.
     Alive,
-    /// Its case has been in flight past the deadline.
+    /// It has said nothing (no message, no heartbeat) for longer than the
+    /// limit while a case was in flight.
     Hung {
         /// How long the case has been in flight.
         took: Duration,
-        /// The deadline it passed.
+        /// How long the worker has been silent.
+        silent: Duration,
+        /// The limit it passed.
         deadline: Duration,
     },
     /// Its process exited or its node is gone.
@@ -70,7 +73,6 @@ impl<'a> Supervisor<'a> {
             args,
             children: BTreeMap::new(),
             next_index: 0,
-            longest_case: Duration::ZERO,
         }
     }
 
@@ -131,6 +133,13 @@ impl<'a> Supervisor<'a> {
             let _ = c.kill();
             let _ = c.wait();
         }
+        self.forget_heartbeat(k);
+    }
+
+    fn forget_heartbeat(&self, k: usize) {
+        if let Ok(p) = protocol::heartbeat_path(self.args.run_id, k) {
+            let _ = std::fs::remove_file(p);
+        }
     }
 
     /// List the nodes of the system (and clean up after dead ones).
@@ -159,22 +168,23 @@ impl<'a> Supervisor<'a> {
         }
     }
 
-    /// A case was recorded after `took` in flight (raises the deadline).
-    pub fn case_finished(&mut self, took: Duration) {
-        self.longest_case = self.longest_case.max(took);
+    /// How long a worker with a case in flight may be silent.
+    pub fn case_deadline(&self) -> Duration {
+        self.args.case_timeout
     }
 
-    /// How long a case may be in flight before its worker counts as hung:
-    /// max(`run.case_timeout_s`, HUNG_FACTOR × the longest case so far).
-    pub fn case_deadline(&self) -> Duration {
-        self.args
-            .case_timeout
-            .max(self.longest_case.mul_f64(crate::config::HUNG_FACTOR))
+    /// How long ago worker `k` last beat, if it ever did.
+    fn since_heartbeat(&self, k: usize) -> Option<Duration> {
+        let path = protocol::heartbeat_path(self.args.run_id, k).ok()?;
+        let beat = protocol::read_heartbeat(&path)?;
+        let now = SystemTime::now().duration_since(UNIX_EPOCH).ok()?;
+        Some(now.saturating_sub(Duration::from_nanos(beat)))
     }
 
     /// Judge worker `k`: `registered` when it has sent a message (only then
     /// is a missing node meaningful), `in_flight_for` how long its case has
-    /// been in flight to it.
+    /// been in flight to it. Silence is counted from the later of the
+    /// dispatch and the worker's last heartbeat.
     pub fn verdict(
         &mut self,
         k: usize,
@@ -184,8 +194,13 @@ impl<'a> Supervisor<'a> {
     ) -> Verdict {
         let deadline = self.case_deadline();
         if let Some(took) = in_flight_for {
-            if took > deadline {
-                return Verdict::Hung { took, deadline };
+            let silent = self.since_heartbeat(k).map_or(took, |b| b.min(took));
+            if silent > deadline {
+                return Verdict::Hung {
+                    took,
+                    silent,
+                    deadline,
+                };
             }
         }
         let exited = self.exited(k).unwrap_or(false);
@@ -199,8 +214,12 @@ impl<'a> Supervisor<'a> {
         }
     }
 
-    /// Give the workers 2 s to exit after `Done`, then kill the stragglers.
+    /// Give the workers 2 s to exit after `Done`, then kill the stragglers;
+    /// remove every heartbeat file of the run.
     pub fn stop_all(&mut self) {
+        for k in 0..self.next_index {
+            self.forget_heartbeat(k);
+        }
         let deadline = Instant::now() + Duration::from_secs(2);
         for c in self.children.values_mut() {
             while Instant::now() < deadline && matches!(c.try_wait(), Ok(None)) {

@@ -1,0 +1,92 @@
+//! Will the workers fit in memory? An estimate of one worker's peak from the
+//! grid and the kernels it keeps, checked against what the machine has
+//! available before any worker starts, so that a sweep is refused with the
+//! numbers instead of starting workers that cannot finish. Owns no files
+//! but `/proc/meminfo`, which it only reads.
+
+use anyhow::{bail, Result};
+
+/// Peak bytes per grid cell of a worker solving a coupled case with one
+/// resident kernel: measured peaks 131.2 MB at 512² (500 B/cell), 502 MB at
+/// 1024² (479) and 1.92 GB at 2048² (458), docs/performance.md; 520 leaves
+/// a margin.
+const BYTES_PER_CELL: f64 = 520.0;
+
+/// Bytes per cell of each further resident kernel (another material): the
+/// stored spectra (144 B/cell), the coarse levels and plans.
+const KERNEL_BYTES_PER_CELL: f64 = 180.0;
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Estimated peak bytes of one worker on an `n x n` grid holding `kernels`
+/// kernels (at least one).
+pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
+    let cells = (n * n) as f64;
+    cells * (BYTES_PER_CELL + KERNEL_BYTES_PER_CELL * kernels.saturating_sub(1) as f64)
+}
+
+/// `MemAvailable` of `/proc/meminfo`, bytes; `None` where it cannot be read.
+pub fn available_bytes() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// Refuses `workers` processes of `per_worker` bytes each when they exceed
+/// `available` (unknown: no check), saying how many would fit.
+pub fn check_fits(
+    what: &str,
+    per_worker: f64,
+    workers: usize,
+    available: Option<f64>,
+) -> Result<()> {
+    let Some(available) = available else {
+        return Ok(());
+    };
+    let total = per_worker * workers as f64;
+    if total <= available {
+        return Ok(());
+    }
+    let fit = (available / per_worker).floor() as usize;
+    let advice = if fit == 0 {
+        "not even one worker fits: use a coarser grid (grid.points)".to_string()
+    } else {
+        format!("--workers {fit} would fit")
+    };
+    bail!(
+        "{what} needs about {:.2} GiB per worker × {workers} worker(s) = {:.2} GiB, but {:.2} GiB of memory are available; {advice}",
+        per_worker / GIB,
+        total / GIB,
+        available / GIB
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn issue20_item4_workers_that_cannot_fit_are_refused_with_the_estimate() {
+        // 2048² with 2 materials: 4.19 M cells × 700 B = 2.73 GiB a worker.
+        let per = worker_bytes(2048, 2);
+        assert!((per / GIB - 2.734).abs() < 0.001, "{}", per / GIB);
+        let e = check_fits("the sweep", per, 4, Some(6.0 * GIB))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("2.73 GiB per worker × 4") && e.contains("--workers 2 would fit"),
+            "{e}"
+        );
+        let e = check_fits("the sweep", per, 1, Some(1.0 * GIB))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not even one worker fits"), "{e}");
+        check_fits("the sweep", per, 2, Some(6.0 * GIB)).unwrap();
+        check_fits("the sweep", per, 64, None).unwrap();
+        // The estimate covers the measured 512² peak (131.2 MB) without
+        // doubling it.
+        let at512 = worker_bytes(512, 1);
+        assert!((131.2e6..1.5 * 131.2e6).contains(&at512), "{at512}");
+    }
+}
