@@ -435,12 +435,12 @@ fn hung_worker_is_killed_and_replaced_and_the_active_run_is_private() {
         let root = protocol::ipc_root_dir().unwrap();
         let mode = std::fs::metadata(&root).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, 0o700, "{}", root.display());
-        // Segments of this run: owner-only (iceoryx2's 16-byte global_mgmt
-        // counter is the one exception, see docs/faults.md).
+        // Files of this run: owner-only, iceoryx2's global_mgmt counter
+        // included (#20 item 3; iceoryx2 creates it 0666).
         let mut segments = 0;
         for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
             let name = e.file_name().to_string_lossy().to_string();
-            if name.starts_with(&prefix("f")) && !name.ends_with("global_mgmt") {
+            if name.starts_with(&prefix("f")) {
                 let mode = e.metadata().unwrap().permissions().mode() & 0o777;
                 assert_eq!(mode & 0o077, 0, "{name} has mode {mode:o}");
                 segments += 1;
@@ -821,4 +821,84 @@ case_timeout_s = 0.5
         let seconds: f64 = row[col("seconds")].parse().unwrap();
         assert!(seconds > 1.0, "the case was not long: {seconds} s");
     }
+}
+
+/// Runs `cmd`, killing it (and failing) if it has not ended within `secs`.
+fn output_within(mut cmd: Command, secs: u64) -> Output {
+    let child = cmd
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = done.clone();
+    let watchdog = std::thread::spawn(move || {
+        let t = std::time::Instant::now();
+        while !flag.load(std::sync::atomic::Ordering::SeqCst) {
+            if t.elapsed().as_secs() >= secs {
+                let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
+                return true;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        false
+    });
+    let out = child.wait_with_output().unwrap();
+    done.store(true, std::sync::atomic::Ordering::SeqCst);
+    assert!(
+        !watchdog.join().unwrap(),
+        "still running after {secs} s: a hang"
+    );
+    out
+}
+
+/// #20 item 3: iceoryx2's node counter (`<prefix>…global_mgmt`, created
+/// 0666) is restricted to its user; a counter left empty (a crash, or
+/// another user emptying it: every run then waited forever) or filled with
+/// garbage (`UnableToGenerateUniqueNodeId`) is recovered with a note; one
+/// that belongs to another user is refused, naming it.
+#[test]
+fn issue20_item3_the_node_counter_is_private_and_recovered_when_damaged() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let dir = scratch("counter");
+    let counter = || {
+        std::fs::read_dir("/dev/shm")
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .find(|p| {
+                let n = p.file_name().unwrap().to_string_lossy().to_string();
+                n.starts_with(&prefix("c")) && n.ends_with("global_mgmt")
+            })
+    };
+    let first = output_within(sweep_cmd(&dir, "o1", 1, "c"), 120);
+    check_ok(&first, "first sweep");
+    let file = counter().expect("iceoryx2 made no node counter");
+    let mode = std::fs::metadata(&file).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600, "{}", file.display());
+    // Emptied: the next run recovers instead of waiting forever.
+    std::fs::write(&file, b"").unwrap();
+    let out = output_within(sweep_cmd(&dir, "o2", 1, "c"), 120);
+    check_ok(&out, "sweep after an emptied counter");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("empty iceoryx2 node counter"));
+    // Garbage: recovered too.
+    std::fs::write(&file, [0xffu8; 16]).unwrap();
+    let out = output_within(sweep_cmd(&dir, "o3", 1, "c"), 120);
+    check_ok(&out, "sweep after a garbage counter");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("was unusable"));
+    // Another user's file under this user's prefix: refused, named.
+    let file = counter().unwrap();
+    let me = std::fs::metadata("/proc/self").unwrap().uid();
+    if me == 0 {
+        let nobody = Command::new("chown").arg("65534").arg(&file).status();
+        if nobody.is_ok_and(|s| s.success()) {
+            let out = output_within(sweep_cmd(&dir, "o4", 1, "c"), 60);
+            assert!(!out.status.success());
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains("belongs to user id 65534"), "{err}");
+        }
+    }
+    let _ = std::fs::remove_file(&file);
+    assert_eq!(shm_leftovers("c"), Vec::<String>::new());
 }

@@ -121,8 +121,9 @@ pub fn read_heartbeat(path: &std::path::Path) -> Option<u64> {
     Some(u64::from_le_bytes(bytes.get(..8)?.try_into().ok()?))
 }
 
-/// The iceoryx2 configuration shared by every process of every run: fixed
-/// prefix [`IPC_PREFIX`] (or `$MPCONTACT_IPC_PREFIX`), per-user root directory
+/// The iceoryx2 configuration shared by every process of every run: the
+/// per-user prefix `mpcontact_u<uid>_` (or `$MPCONTACT_IPC_PREFIX`, which
+/// must start with [`IPC_PREFIX`]), per-user root directory
 /// [`ipc_root_dir`]. Never reads iceoryx2 config files.
 pub fn ipc_config() -> Result<Config, IpcSetupError> {
     let prefix = match std::env::var(IPC_PREFIX_ENV) {
@@ -132,7 +133,8 @@ pub fn ipc_config() -> Result<Config, IpcSetupError> {
                 "{IPC_PREFIX_ENV}={p:?} must start with {IPC_PREFIX:?} and be shorter than 64 bytes"
             )))
         }
-        Err(_) => IPC_PREFIX.to_string(),
+        // Per user: another user's runs never touch this user's files.
+        Err(_) => format!("{IPC_PREFIX}u{}_", uid()?),
     };
     let root = ipc_root_dir()?;
     let mut root_str = root
@@ -244,12 +246,111 @@ pub fn create_node(
 ) -> Result<Node<ipc::Service>, IpcSetupError> {
     let node_name = NodeName::new(name)
         .map_err(|e| IpcSetupError(format!("invalid node name {name:?}: {e:?}")))?;
-    NodeBuilder::new()
-        .name(&node_name)
-        .config(cfg)
-        .signal_handling_mode(signals)
-        .create::<ipc::Service>()
-        .map_err(|e| IpcSetupError(format!("cannot create node {name}: {e:?}")))
+    let prefix = cfg.global.prefix.to_string();
+    let me = uid()?;
+    check_global_mgmt(&prefix, me)?;
+    let create = || {
+        NodeBuilder::new()
+            .name(&node_name)
+            .config(cfg)
+            .signal_handling_mode(signals)
+            .create::<ipc::Service>()
+    };
+    let node = match create() {
+        Ok(node) => node,
+        // A counter file of ours that iceoryx2 cannot use (left damaged by
+        // a crash): ours to recover, once.
+        Err(e) if format!("{e:?}").contains("UnableToGenerateUniqueNodeId") => {
+            let removed = remove_global_mgmt(&prefix, me);
+            eprintln!(
+                "note: the iceoryx2 node counter of prefix {prefix} was unusable ({e:?}); removed {removed} file(s) and tried again"
+            );
+            create().map_err(|e| IpcSetupError(format!("cannot create node {name}: {e:?}")))?
+        }
+        Err(e) => return Err(IpcSetupError(format!("cannot create node {name}: {e:?}"))),
+    };
+    restrict_global_mgmt(&prefix, me)?;
+    Ok(node)
+}
+
+/// Where iceoryx2 keeps its per-prefix node counter (`<prefix>…global_mgmt`,
+/// 16 bytes), which it creates world-writable (0666) and never removes.
+const SHM_DIR: &str = "/dev/shm";
+
+/// The counter files of `prefix` (normally one).
+fn global_mgmt_files(prefix: &str) -> Vec<(std::path::PathBuf, std::fs::Metadata)> {
+    let Ok(dir) = std::fs::read_dir(SHM_DIR) else {
+        return Vec::new();
+    };
+    dir.flatten()
+        .filter(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            name.starts_with(prefix) && name.ends_with("global_mgmt")
+        })
+        .filter_map(|e| Some((e.path(), std::fs::symlink_metadata(e.path()).ok()?)))
+        .collect()
+}
+
+/// How long an empty counter file may stay empty before it counts as left
+/// by a crash (iceoryx2 creates it empty and sizes it at once).
+const EMPTY_GRACE: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Before a node is created: a counter file of another user under our
+/// prefix is an error that says so (iceoryx2 would hang or fail obscurely);
+/// one of ours that stays empty for [`EMPTY_GRACE`] — a crash, or another
+/// user emptying it while it was writable — is removed, since iceoryx2
+/// waits forever for an empty counter to be initialised.
+fn check_global_mgmt(prefix: &str, me: u32) -> Result<(), IpcSetupError> {
+    for (path, meta) in global_mgmt_files(prefix) {
+        if meta.uid() != me {
+            return Err(IpcSetupError(format!(
+                "{} belongs to user id {}, not to this user ({me}); another user created it under this user's iceoryx2 prefix. Set {IPC_PREFIX_ENV}={IPC_PREFIX}<something>_ to use another prefix",
+                path.display(),
+                meta.uid()
+            )));
+        }
+        if meta.len() != 0 {
+            continue;
+        }
+        let since = std::time::Instant::now();
+        let mut empty = true;
+        while empty && since.elapsed() < EMPTY_GRACE {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            empty = std::fs::metadata(&path).is_ok_and(|m| m.len() == 0);
+        }
+        if empty {
+            std::fs::remove_file(&path).map_err(|e| {
+                IpcSetupError(format!("cannot remove the empty {}: {e}", path.display()))
+            })?;
+            eprintln!(
+                "note: removed {}: an empty iceoryx2 node counter (left by a crash) would make the run wait forever",
+                path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Removes this user's counter files of `prefix`; returns how many.
+fn remove_global_mgmt(prefix: &str, me: u32) -> usize {
+    global_mgmt_files(prefix)
+        .into_iter()
+        .filter(|(_, m)| m.uid() == me)
+        .filter(|(p, _)| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// After a node is created: the counter file is this user's only (0600).
+fn restrict_global_mgmt(prefix: &str, me: u32) -> Result<(), IpcSetupError> {
+    for (path, meta) in global_mgmt_files(prefix) {
+        if meta.uid() == me && meta.mode() & 0o077 != 0 {
+            std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).map_err(
+                |e| IpcSetupError(format!("cannot restrict {} to 0600: {e}", path.display())),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// State of the node named `name` under `cfg`: `Some(true)` alive,
