@@ -43,6 +43,20 @@ enum Cmd {
         /// Override one config key, e.g. --set grid.points=128.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
+        /// Check everything and print what the sweep would do; solve nothing, write nothing.
+        #[arg(long)]
+        dry_run: bool,
+    },
+    /// Load and check a config and print what `run` would do (= run --dry-run).
+    Check {
+        /// Config file.
+        config: PathBuf,
+        /// Number of worker processes (default: number of cores).
+        #[arg(long)]
+        workers: Option<usize>,
+        /// Override one config key.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
     },
     /// Solve one case in-process and write case.json and the fields.
     Solve {
@@ -130,21 +144,44 @@ fn kernel_json(material: &str, angles: &[f64]) -> Result<String> {
 }
 
 fn materials_table() -> String {
-    let mut s = String::from("name       kind         E_eq_GPa  nu_eq   constants (GPa)\n");
+    let mut s =
+        String::from("name       kind         E_eq_GPa  nu_eq   constants (GPa)  [source]\n");
     for m in solver::presets::materials() {
         let model = m.model();
-        let (kind, consts) = (model.kind(), model.describe());
         s.push_str(&format!(
-            "{:<10} {:<12} {:>8.2}  {:<6}  {}\n",
+            "{:<10} {:<12} {:>8.2}  {:<6}  {}  [{}]\n",
             m.name,
-            kind,
+            model.kind(),
             m.equivalent.youngs / 1e9,
             m.equivalent.poisson,
-            consts
+            model.describe(),
+            solver::presets::material_source(&m.name)
         ));
     }
-    s.push_str("\n(111) crystals: Table 2 stiffness in the surface frame z ∥ [111] (into the body), x ∥ [1,1,-2];\nE_eq, nu_eq are the paper's isotropic-equivalent values, used to normalise.\n");
+    s.push_str("\nFrame: x, y in the surface, z into the body. (111) crystals: z ∥ [111], x ∥ [1,1,-2], y = z × x;\nE_eq, nu_eq are the paper's isotropic-equivalent values, used only to normalise (Hertz a, p_H) and in\nthe isotropic μa formula. Your own materials: [materials.NAME] in the config (docs/config.md).\n");
     s
+}
+
+/// `--workers`, or the number of cores.
+fn worker_count(workers: Option<usize>) -> Result<usize> {
+    let workers = workers.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if workers == 0 {
+        bail!("--workers must be at least 1");
+    }
+    Ok(workers)
+}
+
+/// The dry-run report, headed by the config's path.
+fn check_report(path: &std::path::Path, config: &Config, workers: usize) -> Result<String> {
+    Ok(format!(
+        "config:    {} (valid)\n{}nothing was solved or written (dry run)\n",
+        path.display(),
+        coordinator::dry_run::report(config, workers)?
+    ))
 }
 
 /// The program workers are started from: this very one. Linux's
@@ -169,16 +206,14 @@ fn real_main() -> Result<()> {
             quiet,
             save_fields,
             sets,
+            dry_run,
         } => {
             let path = config.unwrap_or_else(|| PathBuf::from("configs/quick.toml"));
             let config = Config::load(&path, &sets)?;
-            let workers = workers.unwrap_or_else(|| {
-                std::thread::available_parallelism()
-                    .map(|n| n.get())
-                    .unwrap_or(1)
-            });
-            if workers == 0 {
-                bail!("--workers must be at least 1");
+            let workers = worker_count(workers)?;
+            if dry_run {
+                print!("{}", check_report(&path, &config, workers)?);
+                return Ok(());
             }
             let args = coordinator::run::RunArgs {
                 config,
@@ -221,6 +256,15 @@ fn real_main() -> Result<()> {
                 s.converged,
                 out.join("case.json").display()
             );
+            Ok(())
+        }
+        Cmd::Check {
+            config,
+            workers,
+            sets,
+        } => {
+            let cfg = Config::load(&config, &sets)?;
+            print!("{}", check_report(&config, &cfg, worker_count(workers)?)?);
             Ok(())
         }
         Cmd::Kernel {

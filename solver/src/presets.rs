@@ -41,6 +41,18 @@ pub fn materials() -> Vec<Material> {
     ]
 }
 
+/// Where a preset material's constants come from.
+pub fn material_source(name: &str) -> &'static str {
+    match name {
+        "Fe" => "paper Table 1(a): isotropic E, ν",
+        "Cu" | "Ni" => "paper Table 1(c): isotropic E, ν",
+        "Fe(111)" | "Cu(111)" | "Ni(111)" => {
+            "paper Table 2: stiffness in the (111) frame; E, ν of Table 1 (normalisation only)"
+        }
+        _ => "",
+    }
+}
+
 /// A preset material by name (case-sensitive, as printed by `mpcontact materials`).
 pub fn material(name: &str) -> Option<Material> {
     materials().into_iter().find(|m| m.name == name)

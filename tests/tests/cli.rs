@@ -202,3 +202,38 @@ fn issue20_item11_out_that_is_a_file_is_named() {
     );
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
+
+#[test]
+fn dry_run_of_the_paper_sweep_reports_260_cases_and_writes_nothing() {
+    let tmp_dir = temp_dir("dry");
+    let out_dir = tmp_dir.path().join("never");
+    let config = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../configs/paper-1c-sweep.toml"
+    );
+    let out = run(&[
+        "run",
+        config,
+        "--dry-run",
+        "--out",
+        &out_dir.display().to_string(),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("cases:     260 = 4 materials x 5 surfaces x 13 angles"),
+        "{text}"
+    );
+    assert!(text.contains("kernels:   4") && text.contains("memory:") && text.contains("time:"));
+    assert!(!out_dir.exists(), "a dry run wrote {}", out_dir.display());
+    // `check` says the same; a bad config fails as `run` would.
+    let check = run(&["check", config]);
+    assert!(String::from_utf8_lossy(&check.stdout).contains("cases:     260"));
+    let bad = run(&["check", config, "--set", "load.normal_n=-1"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("load.normal_n"));
+}

@@ -156,6 +156,19 @@ impl FileStore {
         })
     }
 
+    /// Whether an entry for `key` is stored (its header names the key; the
+    /// data are checked only when it is loaded). For dry runs.
+    pub fn holds(&self, key: &KernelKey) -> bool {
+        let Ok(mut f) = std::fs::File::open(self.path(key)) else {
+            return false;
+        };
+        let mut head = vec![0u8; 16 + key.as_str().len()];
+        f.read_exact(&mut head).is_ok()
+            && &head[..8] == MAGIC
+            && head[8..16] == (key.as_str().len() as u64).to_le_bytes()
+            && &head[16..] == key.as_str().as_bytes()
+    }
+
     fn path(&self, key: &KernelKey) -> PathBuf {
         // FNV-1a of the key names the file; the key itself is stored and checked.
         let mut h: u64 = 0xcbf29ce484222325;

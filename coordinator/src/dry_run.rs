@@ -1,0 +1,133 @@
+//! What a sweep will do, without doing it: `mpcontact check CONFIG` and
+//! `mpcontact run CONFIG --dry-run`. The expanded sweep, the kernels to
+//! build or found in the cache, and estimates of memory and time. Reads the
+//! config and the kernel cache's headers; writes nothing.
+
+use anyhow::Result;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use crate::config::Config;
+use solver::KernelKey;
+
+/// Mean seconds of one case on a 384² grid (paper Table 1(c) conditions:
+/// coupled partial slip, patterned and flat, isotropic and (111)): 0.98 s,
+/// the mean of the 260 cases of `configs/paper-1c-sweep.toml` on the 2-core
+/// development machine at 0334c60.
+const CASE_SECONDS_384: f64 = 0.98;
+
+/// A case's time grows like N^2.5 (the transforms' N² log N and the
+/// iterations' slow growth with N): 0.064 s mean at 128² (configs/quick.toml)
+/// against 0.98 s at 384², (384/128)^2.48 = 15.3.
+const CASE_EXPONENT: f64 = 2.5;
+
+/// Seconds to build one kernel at 384² (isotropic or anisotropic; both
+/// measured 0.35 s), growing like N².
+const KERNEL_SECONDS_384: f64 = 0.35;
+
+/// Estimated seconds of one case on an `n x n` grid.
+pub fn case_seconds(n: usize) -> f64 {
+    CASE_SECONDS_384 * (n as f64 / 384.0).powf(CASE_EXPONENT)
+}
+
+/// Estimated seconds to build one kernel on an `n x n` grid.
+pub fn kernel_seconds(n: usize) -> f64 {
+    KERNEL_SECONDS_384 * (n as f64 / 384.0).powi(2)
+}
+
+fn human_seconds(s: f64) -> String {
+    if s < 90.0 {
+        format!("{s:.0} s")
+    } else if s < 5400.0 {
+        format!("{:.1} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
+/// The dry-run report of `config` run on `workers` workers; errors exactly as
+/// `run` would give them before starting (config, memory).
+pub fn report(config: &Config, workers: usize) -> Result<String> {
+    let cases = config.cases()?;
+    anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
+    let n = config.grid.points;
+    let angles = config.sweep.angles_deg.values()?;
+    // Kernels in first-use order, with whether the store holds them.
+    let store = worker::kernel_store::FileStore::default_location()
+        .map(worker::kernel_store::FileStore::new);
+    let mut kernels: BTreeMap<KernelKey, (String, bool, bool)> = BTreeMap::new();
+    for (key, spec) in &cases {
+        let persistent = spec.material.model().persist_tables();
+        kernels.entry(KernelKey::of(spec)).or_insert_with(|| {
+            let k = KernelKey::of(spec);
+            let cached = persistent && store.as_ref().is_some_and(|s| s.holds(&k));
+            (key.material.clone(), persistent, cached)
+        });
+    }
+    let per_worker = crate::memory::worker_bytes(n, kernels.len());
+    crate::memory::check_fits(
+        "the sweep",
+        per_worker,
+        workers,
+        crate::memory::available_bytes(),
+    )?;
+    let mut s = String::new();
+    let mm = n as f64 * config.grid.spacing_um / 1000.0;
+    let _ = writeln!(
+        s,
+        "grid:      {n} x {n} cells of {} µm ({mm:.2} mm square domain)",
+        config.grid.spacing_um
+    );
+    let list = |v: &[String]| v.join(", ");
+    let _ = writeln!(
+        s,
+        "materials: {} ({})",
+        config.sweep.materials.len(),
+        list(&config.sweep.materials)
+    );
+    let _ = writeln!(
+        s,
+        "surfaces:  {} ({})",
+        config.sweep.surfaces.len(),
+        list(&config.sweep.surfaces)
+    );
+    let shown: Vec<String> = angles.iter().map(|a| format!("{a}")).collect();
+    let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
+    let _ = writeln!(
+        s,
+        "cases:     {} = {} materials x {} surfaces x {} angles",
+        cases.len(),
+        config.sweep.materials.len(),
+        config.sweep.surfaces.len(),
+        angles.len()
+    );
+    let to_build = kernels.values().filter(|(_, _, cached)| !cached).count();
+    let _ = writeln!(
+        s,
+        "kernels:   {} ({to_build} to build, {} from the cache)",
+        kernels.len(),
+        kernels.len() - to_build
+    );
+    for (material, persistent, cached) in kernels.values() {
+        let what = match (persistent, cached) {
+            (false, _) => "closed form, built each run",
+            (true, true) => "anisotropic, in the kernel cache",
+            (true, false) => "anisotropic, to build (then cached)",
+        };
+        let _ = writeln!(s, "           {material}: {what}");
+    }
+    let workers_used = workers.min(cases.len()).max(1);
+    let _ = writeln!(
+        s,
+        "memory:    about {:.0} MB per worker x {workers} worker(s) (520 B per cell for one kernel, 180 B per cell per further kernel; measured peaks in docs/performance.md)",
+        per_worker / 1e6
+    );
+    let total = cases.len() as f64 * case_seconds(n) + to_build as f64 * kernel_seconds(n);
+    let _ = writeln!(
+        s,
+        "time:      about {} on {workers_used} worker(s) ({:.2} s a case at {n}², from 0.98 s at 384² scaled as N^2.5; coupled patterned cases on the 2-core development machine, so a guide within a factor of 2)",
+        human_seconds(total / workers_used as f64),
+        case_seconds(n)
+    );
+    Ok(s)
+}

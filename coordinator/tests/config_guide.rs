@@ -1,0 +1,145 @@
+//! The config guide cannot rot: every key config loading accepts is
+//! documented in docs/config.md (and nothing else is), and every worked
+//! example in configs/examples loads and solves on a small grid.
+
+use coordinator::config::{Config, CubicCfg, IsoCfg, MaterialCfg, RunCfg, SurfaceCfg};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+}
+
+/// Keys whose value is an inline table or list documented as one key.
+const LEAVES: &[&str] = &["isotropic", "cubic_gpa", "equivalent", "angles_deg"];
+
+fn walk(prefix: &str, v: &toml::Value, out: &mut BTreeSet<String>) {
+    match v {
+        toml::Value::Table(t) => {
+            for (k, v) in t {
+                let path = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                if LEAVES.contains(&k.as_str()) {
+                    out.insert(path);
+                } else {
+                    walk(&path, v, out);
+                }
+            }
+        }
+        _ => {
+            out.insert(prefix.to_string());
+        }
+    }
+}
+
+/// Every key config loading accepts: a config with every optional key set,
+/// as TOML, its tables named `NAME`.
+fn accepted_keys() -> BTreeSet<String> {
+    let mut c = Config::parse(
+        &std::fs::read_to_string(root().join("configs/quick.toml")).unwrap(),
+        &[],
+    )
+    .unwrap();
+    let iso = IsoCfg {
+        youngs_gpa: 100.0,
+        poisson: 0.3,
+    };
+    c.materials.insert(
+        "NAME".into(),
+        MaterialCfg {
+            isotropic: Some(iso),
+            stiffness_gpa: Some(vec![vec![1.0; 6]; 6]),
+            cubic_gpa: Some(CubicCfg {
+                c11: 1.0,
+                c12: 0.5,
+                c44: 0.5,
+            }),
+            normal: Some([0.0, 0.0, 1.0]),
+            x_dir: Some([1.0, 0.0, 0.0]),
+            equivalent: Some(iso),
+        },
+    );
+    let surface: SurfaceCfg = toml::from_str(
+        "shape = 'circle'\ndiameter_um = 1.0\nside_um = 1.0\nwidth_um = 1.0\npitch_um = 2.0\nheight_um = 1.0\nlattice = 'square'\nangle_deg = 0.0\nfile = 'x.npy'\n",
+    )
+    .unwrap();
+    c.surfaces.insert("NAME".into(), surface);
+    c.run = RunCfg {
+        case_timeout_s: 5.0,
+    };
+    let v = toml::Value::try_from(&c).unwrap();
+    let mut keys = BTreeSet::new();
+    walk("", &v, &mut keys);
+    keys
+}
+
+/// The keys of the guide's tables: the first backticked word of each row.
+fn documented_keys() -> BTreeSet<String> {
+    let text = std::fs::read_to_string(root().join("docs/config.md")).unwrap();
+    text.lines()
+        .filter_map(|l| l.strip_prefix("| `"))
+        .filter_map(|l| l.split('`').next())
+        .filter(|k| k.contains('.') && !k.contains('/'))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn every_accepted_key_is_documented_and_every_documented_key_accepted() {
+    let accepted = accepted_keys();
+    let documented = documented_keys();
+    assert!(accepted.len() >= 30, "{accepted:?}");
+    let missing: Vec<_> = accepted.difference(&documented).collect();
+    let extra: Vec<_> = documented.difference(&accepted).collect();
+    assert!(
+        missing.is_empty() && extra.is_empty(),
+        "keys accepted but not in docs/config.md: {missing:?}; documented but not accepted: {extra:?}"
+    );
+}
+
+#[test]
+fn every_example_loads_and_solves_on_a_small_grid() {
+    let dir = root().join("configs/examples");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 5, "{names:?}");
+    let mut solved = 0;
+    for path in names {
+        let full = Config::load(&path, &[]).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        assert!(!full.cases().unwrap().is_empty());
+        // Every material and surface of the example, at its first angle, on
+        // 64 cells (a height map keeps its own grid, which is 64 already).
+        let first = full.sweep.angles_deg.values().unwrap()[0];
+        let sets = [
+            "grid.points=64".to_string(),
+            format!(
+                "grid.spacing_um={}",
+                full.grid.spacing_um * full.grid.points as f64 / 64.0
+            ),
+            format!("sweep.angles_deg=[{first:?}]"),
+        ];
+        let small =
+            Config::load(&path, &sets).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        let mut cache = solver::KernelCache::new();
+        for (key, spec) in small.cases().unwrap() {
+            let out = solver::solve_case(&spec, &mut cache)
+                .unwrap_or_else(|e| panic!("{}: {key}: {e}", path.display()));
+            assert!(
+                out.scalars.converged,
+                "{}: {key} did not converge",
+                path.display()
+            );
+            let mu = out.scalars.mu_a.expect("a tangential load gives μa");
+            assert!(mu > 0.1 && mu < 1.0, "{}: {key}: μa = {mu}", path.display());
+            solved += 1;
+        }
+    }
+    assert!(solved >= 9, "{solved} cases");
+}
