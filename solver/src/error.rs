@@ -50,3 +50,16 @@ impl SolverError {
         }
     }
 }
+
+/// `Ok` when `v` is positive and finite; otherwise an `Invalid` error naming
+/// `param`: "{what} must be positive and finite, got {v}{unit}".
+pub(crate) fn positive(param: &str, v: f64, what: &str, unit: &str) -> Result<(), SolverError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(SolverError::invalid(
+            param,
+            format!("{what} must be positive and finite, got {v}{unit}"),
+        ))
+    }
+}

@@ -85,14 +85,7 @@ pub struct CaseSpec {
 }
 
 fn positive(param: &str, v: f64, what: &str) -> Result<(), SolverError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(SolverError::invalid(
-            param,
-            format!("{what} must be positive and finite, got {v}"),
-        ))
-    }
+    crate::error::positive(param, v, what, "")
 }
 
 /// Prefixes the parameter of an `Invalid` error with `prefix.`.

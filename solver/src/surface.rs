@@ -76,14 +76,7 @@ pub enum Surface {
 }
 
 fn positive(field: &str, v: f64, what: &str) -> Result<(), SolverError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(SolverError::invalid(
-            field,
-            format!("{what} must be positive and finite, got {v} m"),
-        ))
-    }
+    crate::error::positive(field, v, what, " m")
 }
 
 impl Surface {

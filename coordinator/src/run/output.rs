@@ -317,14 +317,7 @@ mod tests {
                 tangential_ratio: 0.6,
                 angle_deg: 30.0,
             },
-            numerics: solver::Numerics {
-                coupling: false,
-                tolerance: 1e-8,
-                tangential_tolerance: 1e-6,
-                max_iterations: 100,
-                coupling_tolerance: 1e-6,
-                max_coupling_iterations: 5,
-            },
+            numerics: super::super::plan::tests::quick_numerics(),
         };
         let key = CaseKey::new("Cu(111)", surface_name, 30.0);
         let mut plan = super::super::plan::Plan::new(vec![(key, spec)]);

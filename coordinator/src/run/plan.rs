@@ -169,7 +169,7 @@ impl Plan {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use solver::{Grid, Load, Material, Numerics};
 
@@ -185,14 +185,19 @@ mod tests {
                 tangential_ratio: 0.5,
                 angle_deg: angle,
             },
-            numerics: Numerics {
-                coupling: false,
-                tolerance: 1e-8,
-                tangential_tolerance: 1e-6,
-                max_iterations: 100,
-                coupling_tolerance: 1e-6,
-                max_coupling_iterations: 5,
-            },
+            numerics: quick_numerics(),
+        }
+    }
+
+    /// Loose, uncoupled settings for plan and output tests (nothing is solved).
+    pub(crate) fn quick_numerics() -> Numerics {
+        Numerics {
+            coupling: false,
+            tolerance: 1e-8,
+            tangential_tolerance: 1e-6,
+            max_iterations: 100,
+            coupling_tolerance: 1e-6,
+            max_coupling_iterations: 5,
         }
     }
 
