@@ -6,6 +6,7 @@
 //! judges, `dispatch` acts.
 
 use std::collections::{BTreeMap, HashMap};
+use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -92,7 +93,10 @@ impl<'a> Supervisor<'a> {
         let log_path = log_dir.join(format!("worker-{k}.log"));
         let log = std::fs::File::create(&log_path)
             .with_context(|| format!("cannot create {}", log_path.display()))?;
+        // Named `mpcontact` in process lists even when started through
+        // /proc/self/exe.
         let child = Command::new(self.args.exe)
+            .arg0("mpcontact")
             .args([
                 "worker",
                 "--run",
