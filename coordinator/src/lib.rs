@@ -13,4 +13,5 @@ pub mod maps;
 pub mod memory;
 pub mod npy;
 pub mod run;
+pub mod shard;
 pub mod solve;

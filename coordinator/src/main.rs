@@ -46,6 +46,19 @@ enum Cmd {
         /// Check everything and print what the sweep would do; solve nothing, write nothing.
         #[arg(long)]
         dry_run: bool,
+        /// Run only shard K of N (0-based), e.g. 0/4; `slurm` reads
+        /// SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT. Merge with `mpcontact merge`.
+        #[arg(long)]
+        shard: Option<String>,
+    },
+    /// Merge the output directories of a sharded sweep into one run's outputs.
+    Merge {
+        /// The shard directories (all N of them).
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Output directory of the merged results.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Load and check a config and print what `run` would do (= run --dry-run).
     Check {
@@ -207,7 +220,12 @@ fn real_main() -> Result<()> {
             save_fields,
             sets,
             dry_run,
+            shard,
         } => {
+            let shard = shard
+                .as_deref()
+                .map(coordinator::shard::Shard::parse)
+                .transpose()?;
             let path = config.unwrap_or_else(|| PathBuf::from("configs/quick.toml"));
             let config = Config::load(&path, &sets)?;
             let workers = worker_count(workers)?;
@@ -223,6 +241,7 @@ fn real_main() -> Result<()> {
                 quiet,
                 save_fields,
                 exe: worker_exe()?,
+                shard,
             };
             coordinator::run::run_sweep(&args)?;
             Ok(())
@@ -255,6 +274,19 @@ fn real_main() -> Result<()> {
                 s.mu_a.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
                 s.converged,
                 out.join("case.json").display()
+            );
+            Ok(())
+        }
+        Cmd::Merge { shards, out } => {
+            let s = coordinator::run::merge_shards(&shards, &out)?;
+            eprintln!(
+                "merged {} shards: {} cases, {} ok, {} not converged, {} failed → {}",
+                shards.len(),
+                s.total,
+                s.ok,
+                s.not_converged,
+                s.failed,
+                out.display()
             );
             Ok(())
         }

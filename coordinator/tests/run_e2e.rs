@@ -902,3 +902,75 @@ fn issue20_item3_the_node_counter_is_private_and_recovered_when_damaged() {
     let _ = std::fs::remove_file(&file);
     assert_eq!(shm_leftovers("c"), Vec::<String>::new());
 }
+
+/// #18: three shards of the sweep, merged, give the single run's outputs;
+/// a merge with a missing shard, a shard given twice, a case recorded twice,
+/// shards of different configs or a shard still running is refused, naming
+/// the shard.
+#[test]
+fn shards_merge_into_the_single_run_and_bad_merges_are_refused() {
+    let dir = scratch("shards");
+    check_ok(
+        &sweep_cmd(&dir, "single", 1, "s").output().unwrap(),
+        "single run",
+    );
+    for k in 0..3 {
+        let mut c = sweep_cmd(&dir, &format!("shard-{k}"), 1, "s");
+        c.args(["--shard", &format!("{k}/3")]);
+        check_ok(&c.output().unwrap(), "shard");
+    }
+    let shard = |k: usize| dir.join(format!("shard-{k}"));
+    let merge = |dirs: &[PathBuf], out: &str| {
+        Command::new(EXE)
+            .arg("merge")
+            .args(dirs)
+            .arg("--out")
+            .arg(dir.join(out))
+            .output()
+            .unwrap()
+    };
+    let all: Vec<PathBuf> = (0..3).map(shard).collect();
+    check_ok(&merge(&all, "merged"), "merge");
+    // Compared: curves.csv and both plots byte for byte, results.csv without
+    // the seconds and worker columns.
+    for f in ["curves.csv", "mu_a_vs_angle.svg", "mu_a_vs_angle.png"] {
+        assert_eq!(
+            std::fs::read(dir.join("merged").join(f)).unwrap(),
+            std::fs::read(dir.join("single").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    assert_eq!(
+        physics_columns(&dir.join("merged/results.csv")),
+        physics_columns(&dir.join("single/results.csv"))
+    );
+    let refused = |dirs: &[PathBuf], needle: &str| {
+        let out = merge(dirs, "refused");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{needle}: {err}"
+        );
+    };
+    refused(&all[..2], "missing shard(s) 2/3");
+    refused(&[all.clone(), vec![shard(0)]].concat(), "is given twice");
+    // A shard still running holds its directory's lock.
+    let held = std::fs::File::open(shard(1)).unwrap();
+    held.try_lock().unwrap();
+    refused(&all, "shard-1 is still running");
+    drop(held);
+    // A case recorded twice: shard 0's journal gains a line of shard 1's.
+    let j1 = std::fs::read_to_string(shard(1).join("journal.jsonl")).unwrap();
+    let stolen = j1.lines().nth(1).unwrap().to_string();
+    let j0_path = shard(0).join("journal.jsonl");
+    let j0 = std::fs::read_to_string(&j0_path).unwrap();
+    std::fs::write(&j0_path, format!("{j0}{stolen}\n")).unwrap();
+    refused(&all, "is recorded by two shards");
+    std::fs::write(&j0_path, &j0).unwrap();
+    // Another config: shard 2 rerun with another friction.
+    std::fs::remove_dir_all(shard(2)).unwrap();
+    let mut c = sweep_cmd(&dir, "shard-2", 1, "s");
+    c.args(["--shard", "2/3", "--set", "load.friction=0.31"]);
+    check_ok(&c.output().unwrap(), "shard of another config");
+    refused(&all, "come from different configs");
+}

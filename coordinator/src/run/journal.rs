@@ -110,7 +110,7 @@ pub struct Previous {
     pub torn_tail: bool,
 }
 
-fn first_difference(a: &str, b: &str) -> String {
+pub(crate) fn first_difference(a: &str, b: &str) -> String {
     let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
     for i in 0..la.len().max(lb.len()) {
         let (x, y) = (la.get(i).copied(), lb.get(i).copied());
@@ -236,6 +236,20 @@ impl Journal {
             .write_all(text.as_bytes())
             .and_then(|_| self.file.sync_data())
             .with_context(|| format!("while appending to {}", self.path.display()))
+    }
+
+    /// The config text of a journal's header line.
+    pub fn read_config(path: &Path) -> anyhow::Result<String> {
+        let f = File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let first = BufReader::new(f)
+            .lines()
+            .next()
+            .transpose()?
+            .unwrap_or_default();
+        match serde_json::from_str::<Line>(&first) {
+            Ok(Line::Header { config, .. }) => Ok(config),
+            _ => bail!("{} does not start with a journal header", path.display()),
+        }
     }
 
     /// Read all case lines of a journal file (tests, tools).

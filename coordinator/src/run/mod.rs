@@ -13,6 +13,7 @@ mod dispatch;
 mod exchange;
 mod journal;
 mod lock;
+mod merge;
 mod output;
 mod plan;
 mod progress;
@@ -27,6 +28,7 @@ use anyhow::Context;
 use serde::Serialize;
 
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
+pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
 pub use output::{fmt_f64, CURVES_HEADER, RESULTS_HEADER};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
@@ -50,6 +52,8 @@ pub struct RunArgs {
     /// The `mpcontact` binary; workers are started as
     /// `EXE worker --run RUN_ID --index K`.
     pub exe: PathBuf,
+    /// Run only this shard of the cases (`--shard K/N`).
+    pub shard: Option<crate::shard::Shard>,
 }
 
 fn new_run_id() -> String {
@@ -85,8 +89,21 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     })?;
     let _lock = lock::DirLock::take(&args.out_dir)?;
     let run_id = new_run_id();
-    let plan = Plan::new(args.config.cases()?);
-    anyhow::ensure!(!plan.cases.is_empty(), "the sweep has no cases");
+    let mut cases = args.config.cases()?;
+    anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
+    if let Some(shard) = args.shard {
+        let of = crate::shard::assign(&cases, shard.count);
+        let mut i = 0;
+        cases.retain(|_| {
+            i += 1;
+            of[i - 1] == shard.index
+        });
+        merge::write_shard_info(&args.out_dir, shard, &args.config.base_dir)?;
+        if cases.is_empty() && !args.quiet {
+            eprintln!("shard {shard} has no cases (more shards than the cost balance needs); writing an empty shard");
+        }
+    }
+    let plan = Plan::new(cases);
     let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
     crate::memory::check_fits(
         "the sweep",
@@ -154,7 +171,8 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let solved_now = recorder.recorded() - resumed.cases;
     summary.cases_per_minute = solved_now as f64 / (summary.wall_seconds / 60.0).max(1e-9);
 
-    write_outputs(args, &recorder, &mut summary, &raw)?;
+    let (cases, outcomes) = recorder.results();
+    write_outputs(&args.out_dir, cases, outcomes, &mut summary, &raw)?;
     if !args.quiet {
         eprintln!(
             "{} cases: {} ok, {} not converged, {} failed ({} resumed) in {:.1} s → {}",
@@ -201,14 +219,15 @@ fn start_workers(
     }
 }
 
+/// Writes `results.csv`, `curves.csv`, the plots and `summary.json` of
+/// `cases` with their `outcomes` into `dir` (a run, or a merge of shards).
 fn write_outputs(
-    args: &RunArgs,
-    recorder: &record::Recorder,
+    dir: &std::path::Path,
+    cases: &[PlannedCase],
+    outcomes: &[Option<Outcome>],
     summary: &mut RunSummary,
     raw_config: &str,
 ) -> anyhow::Result<()> {
-    let dir = &args.out_dir;
-    let (cases, outcomes) = recorder.results();
     let rows = output::calibrate(cases, outcomes);
     let write = |name: &str, text: String| crate::atomic::write(&dir.join(name), text.as_bytes());
     write("results.csv", output::results_csv(&rows))?;
