@@ -256,7 +256,17 @@ impl FileStore {
         let path = self.path(key);
         let key = key.as_str();
         // Write to a private temporary name, then rename: readers never see half a file.
-        let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+        // Unique among the processes of every node sharing the directory
+        // (shards of a cluster job may write the same kernel at once).
+        let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let tmp = path.with_extension(format!(
+            "tmp-{}-{}-{nanos}",
+            host.trim(),
+            std::process::id()
+        ));
         let result = (|| {
             let file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
             let mut f = CrcWriter {
@@ -456,5 +466,39 @@ mod tests {
         let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, 0o700);
         assert!(unsafe_dir(&fresh).is_none());
+    }
+
+    #[test]
+    fn concurrent_writers_of_one_kernel_never_show_a_reader_half_an_entry() {
+        // Shards on a shared file system may store the same kernel at once.
+        let (_tmp, dir) = private_store();
+        let spec = spec();
+        let op = solver::build_operator(&spec.material, spec.grid);
+        let spectra = op.spectra().clone();
+        let key = KernelKey::of(&spec);
+        let len = Spectra::len_for(spec.grid.n);
+        let store = FileStore::new(dir.clone());
+        std::thread::scope(|s| {
+            for _ in 0..4 {
+                s.spawn(|| {
+                    for _ in 0..10 {
+                        store.save(&key, &spectra);
+                    }
+                });
+            }
+            s.spawn(|| {
+                for _ in 0..200 {
+                    if let Some(read) = store.load(&key, len) {
+                        assert!(read == spectra, "a reader saw a different entry");
+                    }
+                }
+            });
+        });
+        assert!(store.load(&key, len).is_some_and(|r| r == spectra));
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left.len(), 1, "temporary files left: {left:?}");
     }
 }
