@@ -616,31 +616,17 @@ impl Config {
         if self.sweep.surfaces.is_empty() {
             bail!("sweep.surfaces: list at least one surface");
         }
-        self.sweep.angles_deg.values()?;
         let t = self.run.case_timeout_s;
         // 1e9 s (32 years) keeps the deadline within what a Duration holds.
         if !(t.is_finite() && t > 0.0 && t <= 1e9) {
             bail!("run.case_timeout_s = {t}: must be a positive number of seconds, at most 1e9");
         }
-        let angles = self.sweep.angles_deg.values()?;
-        self.check_unique(&angles)?;
-        for m in &self.sweep.materials {
-            for s in &self.sweep.surfaces {
-                for &a in &angles {
-                    let spec = self.spec(m, s, a)?;
-                    spec.validate().map_err(|e| self.explain(e, m, s))?;
-                }
-            }
-        }
-        // Memory: nine kernel spectra of (2N)(N+1) complex values plus work buffers.
-        let n = self.grid.points as f64;
-        let bytes = 13.0 * 2.0 * n * (n + 1.0) * 16.0 + 40.0 * n * n * 8.0;
-        if bytes > 16.0 * 1024f64.powi(3) {
-            bail!(
-                "grid.points = {}: a worker would need about {:.1} GiB; use at most 2048",
-                self.grid.points,
-                bytes / 1024f64.powi(3)
-            );
+        self.check_unique(&self.sweep.angles_deg.values()?)?;
+        // Whether the workers fit in this machine's memory is checked where
+        // they start (`memory::check_fits`), not here.
+        for (key, spec) in self.cases()? {
+            spec.validate()
+                .map_err(|e| self.explain(e, &key.material, &key.surface))?;
         }
         Ok(())
     }
@@ -701,9 +687,14 @@ impl Config {
 
     /// One case spec.
     pub fn spec(&self, material: &str, surface: &str, angle_deg: f64) -> Result<CaseSpec> {
-        Ok(CaseSpec {
-            material: self.material(material)?,
-            surface: self.surface(surface)?,
+        Ok(self.spec_of(self.material(material)?, self.surface(surface)?, angle_deg))
+    }
+
+    /// The spec of a resolved material and surface at one angle.
+    fn spec_of(&self, material: Material, surface: Surface, angle_deg: f64) -> CaseSpec {
+        CaseSpec {
+            material,
+            surface,
             grid: Grid::square(self.grid.points, self.grid.spacing_um * 1e-6),
             load: Load {
                 indenter_radius_m: self.indenter.radius_mm * 1e-3,
@@ -720,17 +711,26 @@ impl Config {
                 coupling_tolerance: self.solver.coupling_tolerance,
                 max_coupling_iterations: self.solver.max_coupling_iterations,
             },
-        })
+        }
     }
 
     /// All cases of the sweep in a fixed order: materials × surfaces × angles.
+    /// Each material and surface is resolved once.
     pub fn cases(&self) -> Result<Vec<(CaseKey, CaseSpec)>> {
         let angles = self.sweep.angles_deg.values()?;
+        let surfaces = self
+            .sweep
+            .surfaces
+            .iter()
+            .map(|s| Ok((s, self.surface(s)?)))
+            .collect::<Result<Vec<_>>>()?;
         let mut out = Vec::new();
         for m in &self.sweep.materials {
-            for s in &self.sweep.surfaces {
+            let material = self.material(m)?;
+            for (s, surface) in &surfaces {
                 for &a in &angles {
-                    out.push((CaseKey::new(m, s, a), self.spec(m, s, a)?));
+                    let spec = self.spec_of(material.clone(), surface.clone(), a);
+                    out.push((CaseKey::new(m, s, a), spec));
                 }
             }
         }

@@ -8,32 +8,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::config::Config;
+use crate::cost::{case_seconds, kernel_seconds};
 use solver::KernelKey;
-
-/// Mean seconds of one case on a 384² grid (paper Table 1(c) conditions:
-/// coupled partial slip, patterned and flat, isotropic and (111)): 0.98 s,
-/// the mean of the 260 cases of `configs/paper-1c-sweep.toml` on the 2-core
-/// development machine at 0334c60.
-const CASE_SECONDS_384: f64 = 0.98;
-
-/// A case's time grows like N^2.5 (the transforms' N² log N and the
-/// iterations' slow growth with N): 0.064 s mean at 128² (configs/quick.toml)
-/// against 0.98 s at 384², (384/128)^2.48 = 15.3.
-const CASE_EXPONENT: f64 = 2.5;
-
-/// Seconds to build one kernel at 384² (isotropic or anisotropic; both
-/// measured 0.35 s), growing like N².
-const KERNEL_SECONDS_384: f64 = 0.35;
-
-/// Estimated seconds of one case on an `n x n` grid.
-pub fn case_seconds(n: usize) -> f64 {
-    CASE_SECONDS_384 * (n as f64 / 384.0).powf(CASE_EXPONENT)
-}
-
-/// Estimated seconds to build one kernel on an `n x n` grid.
-pub fn kernel_seconds(n: usize) -> f64 {
-    KERNEL_SECONDS_384 * (n as f64 / 384.0).powi(2)
-}
 
 fn human_seconds(s: f64) -> String {
     if s < 90.0 {
@@ -58,11 +34,11 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     let mut kernels: BTreeMap<KernelKey, (String, bool, bool)> = BTreeMap::new();
     for (key, spec) in &cases {
         let persistent = spec.material.model().persist_tables();
-        kernels.entry(KernelKey::of(spec)).or_insert_with(|| {
-            let k = KernelKey::of(spec);
-            let cached = persistent && store.as_ref().is_some_and(|s| s.holds(&k));
-            (key.material.clone(), persistent, cached)
-        });
+        if let std::collections::btree_map::Entry::Vacant(slot) = kernels.entry(KernelKey::of(spec))
+        {
+            let cached = persistent && store.as_ref().is_some_and(|s| s.holds(slot.key()));
+            slot.insert((key.material.clone(), persistent, cached));
+        }
     }
     let per_worker = crate::memory::worker_bytes(n, kernels.len());
     crate::memory::check_fits(
@@ -122,12 +98,13 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         "memory:    about {:.0} MB per worker x {workers} worker(s) (520 B per cell for one kernel, 180 B per cell per further kernel; measured peaks in docs/performance.md)",
         per_worker / 1e6
     );
-    let total = cases.len() as f64 * case_seconds(n) + to_build as f64 * kernel_seconds(n);
+    let solving: f64 = cases.iter().map(|(_, spec)| case_seconds(spec)).sum();
+    let total = solving + to_build as f64 * kernel_seconds(n);
     let _ = writeln!(
         s,
-        "time:      about {} on {workers_used} worker(s) ({:.2} s a case at {n}², from 0.98 s at 384² scaled as N^2.5; coupled patterned cases on the 2-core development machine, so a guide within a factor of 2)",
+        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average at {n}²: the paper sweep's measured means per kind of case at 384², scaled as N^2.5; a guide within a factor of 2)",
         human_seconds(total / workers_used as f64),
-        case_seconds(n)
+        solving / cases.len() as f64
     );
     Ok(s)
 }

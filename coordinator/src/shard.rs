@@ -6,9 +6,10 @@
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
-use solver::{CaseSpec, KernelKey, Surface};
+use solver::{CaseSpec, KernelKey};
 
 use crate::case::CaseKey;
+use crate::cost::{case_seconds, kernel_seconds};
 
 /// Shard `index` of `count` (0-based).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -65,29 +66,11 @@ impl std::fmt::Display for Shard {
     }
 }
 
-/// Expected cost of a case, in mean case-times: measured means of the 260
-/// cases of configs/paper-1c-sweep.toml (384², 2 workers): flat 1.10 s
-/// (isotropic) and 1.13 s ((111)), patterned 0.92 s and 0.97 s. Patterned
-/// cases are *not* dearer here: their contact is smaller; anisotropy adds ~4 %.
-fn case_cost(spec: &CaseSpec) -> f64 {
-    let flat = matches!(spec.surface, Surface::Flat);
-    let aniso = !spec.material.is_isotropic();
-    match (flat, aniso) {
-        (true, false) => 1.10,
-        (true, true) => 1.13,
-        (false, false) => 0.92,
-        (false, true) => 0.97,
-    }
-}
-
-/// Building a kernel costs about a third of a case (0.35 s at 384²).
-const KERNEL_COST: f64 = 0.35;
-
 /// The shard of each case (`cases` in config order), for `count` shards.
 ///
 /// Cases are lined up kernel by kernel (kernels in order of first use,
-/// cases in config order), each with its expected cost (and each kernel's
-/// build with the first of its cases), and the line is cut into `count`
+/// cases in config order), each with its expected cost ([`crate::cost`];
+/// each kernel's build with the first of its cases), and the line is cut into `count`
 /// pieces of equal cost: a shard is balanced to within one case and touches
 /// the fewest kernels a balanced cut allows (with 4 kernels and 2 or 3
 /// shards, at most 2). Deterministic: the same config gives the same shards
@@ -107,8 +90,13 @@ pub fn assign(cases: &[(CaseKey, CaseSpec)], count: usize) -> Vec<usize> {
     let mut at = 0.0;
     for (_, members) in &groups {
         for (j, &i) in members.iter().enumerate() {
-            let build = if j == 0 { KERNEL_COST } else { 0.0 };
-            let c = build + case_cost(&cases[i].1);
+            let spec = &cases[i].1;
+            let build = if j == 0 {
+                kernel_seconds(spec.grid.n)
+            } else {
+                0.0
+            };
+            let c = build + case_seconds(spec);
             line.push((i, c));
             at += c;
         }
@@ -168,7 +156,7 @@ mod tests {
             let mut load = vec![0.0; n];
             let mut kernels = vec![std::collections::BTreeSet::new(); n];
             for (i, &s) in of.iter().enumerate() {
-                load[s] += case_cost(&cases[i].1);
+                load[s] += case_seconds(&cases[i].1);
                 kernels[s].insert(KernelKey::of(&cases[i].1));
             }
             let used = load.iter().filter(|&&l| l > 0.0).count();

@@ -141,7 +141,9 @@ pub fn merge_shards(dirs: &[PathBuf], out_dir: &Path) -> anyhow::Result<RunSumma
     }
     let config = Config::parse_in(&first.config, &[], &first.info.config_dir)
         .context("the shards' config")?;
-    let plan = Plan::new(config.cases()?);
+    let cases = config.cases()?;
+    let of = crate::shard::assign(&cases, count);
+    let plan = Plan::new(cases);
     let mut outcomes: Vec<Option<Outcome>> = vec![None; plan.cases.len()];
     let mut owner: Vec<Option<&Path>> = vec![None; plan.cases.len()];
     for s in &shards {
@@ -169,7 +171,6 @@ pub fn merge_shards(dirs: &[PathBuf], out_dir: &Path) -> anyhow::Result<RunSumma
             outcomes[i] = Some(entry.outcome);
         }
     }
-    let of = crate::shard::assign(&config.cases()?, count);
     let lost: Vec<String> = (0..plan.cases.len())
         .filter(|&i| outcomes[i].is_none())
         .map(|i| format!("{} (shard {}/{count})", plan.cases[i].key, of[i]))

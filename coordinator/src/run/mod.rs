@@ -93,11 +93,12 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
     if let Some(shard) = args.shard {
         let of = crate::shard::assign(&cases, shard.count);
-        let mut i = 0;
-        cases.retain(|_| {
-            i += 1;
-            of[i - 1] == shard.index
-        });
+        cases = cases
+            .into_iter()
+            .zip(of)
+            .filter(|(_, s)| *s == shard.index)
+            .map(|(case, _)| case)
+            .collect();
         merge::write_shard_info(&args.out_dir, shard, &args.config.base_dir)?;
         if cases.is_empty() && !args.quiet {
             eprintln!("shard {shard} has no cases (more shards than the cost balance needs); writing an empty shard");
