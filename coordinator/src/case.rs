@@ -10,7 +10,9 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 /// Which case of a sweep: material × surface × force angle, by the names
-/// the config uses.
+/// the config uses, and the grid level of a convergence ladder (0: the
+/// config's grid; level k has about 2^(k/2) times its points per side on the
+/// same domain).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseKey {
     /// Material name (a preset or a `[materials.*]` key).
@@ -19,6 +21,11 @@ pub struct CaseKey {
     pub surface: String,
     /// Force direction, degrees.
     pub angle_deg: f64,
+    /// Convergence-ladder level. Always serialised: the IPC header's
+    /// bincode is not self-describing, so a field that is sometimes left
+    /// out cannot be read back; journals written before ladders read as 0.
+    #[serde(default)]
+    pub level: usize,
 }
 
 impl CaseKey {
@@ -28,7 +35,19 @@ impl CaseKey {
             material: material.to_string(),
             surface: surface.to_string(),
             angle_deg,
+            level: 0,
         }
+    }
+
+    /// The same case on ladder level `level`.
+    pub fn at_level(mut self, level: usize) -> Self {
+        self.level = level;
+        self
+    }
+
+    /// The key of the curve point this case belongs to (level 0).
+    pub fn point(&self) -> CaseKey {
+        self.clone().at_level(0)
     }
 
     /// The angle as it appears in the display text: `015.0`.
@@ -38,7 +57,8 @@ impl CaseKey {
 }
 
 impl fmt::Display for CaseKey {
-    /// `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`.
+    /// `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`, with
+    /// `/L2` appended on ladder level 2.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
@@ -46,7 +66,11 @@ impl fmt::Display for CaseKey {
             self.material,
             self.surface,
             self.angle_text()
-        )
+        )?;
+        if self.level > 0 {
+            write!(f, "/L{}", self.level)?;
+        }
+        Ok(())
     }
 }
 
@@ -105,6 +129,22 @@ mod tests {
             CaseKey::new("Fe", "flat", 180.0).to_string(),
             "Fe/flat/180.0"
         );
+        assert_eq!(
+            CaseKey::new("Fe", "flat", 180.0).at_level(2).to_string(),
+            "Fe/flat/180.0/L2"
+        );
+    }
+
+    #[test]
+    fn keys_without_a_level_read_as_level_zero() {
+        let k = CaseKey::new("Cu", "flat", 15.0);
+        let old = r#"{"material":"Cu","surface":"flat","angle_deg":15.0}"#;
+        let back: CaseKey = serde_json::from_str(old).unwrap();
+        assert_eq!(back, k);
+        let k2 = k.clone().at_level(1);
+        let back: CaseKey = serde_json::from_str(&serde_json::to_string(&k2).unwrap()).unwrap();
+        assert_eq!(back, k2);
+        assert_eq!(k2.point(), k);
     }
 
     #[test]

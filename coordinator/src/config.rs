@@ -354,6 +354,62 @@ impl RunCfg {
     }
 }
 
+/// `[convergence]`: grid-convergence ladders (docs/validation.md).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvergenceCfg {
+    /// Grids per case: 1 (the config's grid only), 2 or 3 … up to
+    /// [`MAX_LEVELS`]; level k has about 2^(k/2) times the config's points
+    /// per side on the same domain (cell sizes h, h/√2, h/2, …).
+    #[serde(default = "one")]
+    pub levels: usize,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// Most levels a ladder may have (the finest grid has 2^((L−1)/2) times
+/// the points per side, 2.8× at 4: 22× the cost of level 0).
+pub const MAX_LEVELS: usize = 4;
+
+impl Default for ConvergenceCfg {
+    fn default() -> Self {
+        ConvergenceCfg { levels: 1 }
+    }
+}
+
+impl ConvergenceCfg {
+    fn is_default(&self) -> bool {
+        *self == ConvergenceCfg::default()
+    }
+}
+
+/// Points per side of ladder level `level` on a grid of `n`: n·2^(level/2),
+/// odd levels rounded to the nearest 5-smooth number (2^a 3^b 5^c: fast
+/// FFT sizes; 384 → 540, 256 → 360), so the cell-size ratio is √2 to
+/// within 0.5 %; the spacing follows from the fixed domain.
+pub fn ladder_points(n: usize, level: usize) -> usize {
+    let base = n << (level / 2);
+    if level.is_multiple_of(2) {
+        return base;
+    }
+    let target = base as f64 * std::f64::consts::SQRT_2;
+    let smooth = |mut m: usize| {
+        for f in [2, 3, 5] {
+            while m.is_multiple_of(f) {
+                m /= f;
+            }
+        }
+        m == 1
+    };
+    let t = target.round() as usize;
+    (0..t)
+        .flat_map(|d| [t + d, t - d])
+        .find(|&m| m > 0 && smooth(m))
+        .unwrap_or(t)
+}
+
 /// The whole config file.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -382,6 +438,9 @@ pub struct Config {
     /// journals written before it existed still resume).
     #[serde(default, skip_serializing_if = "RunCfg::is_default")]
     pub run: RunCfg,
+    /// `[convergence]` (left out of the echo when it is the default, as `[run]`).
+    #[serde(default, skip_serializing_if = "ConvergenceCfg::is_default")]
+    pub convergence: ConvergenceCfg,
     /// Directory that relative paths in the config (height maps) start from.
     #[serde(skip)]
     pub base_dir: std::path::PathBuf,
@@ -622,6 +681,7 @@ impl Config {
             bail!("run.case_timeout_s = {t}: must be a positive number of seconds, at most 1e9");
         }
         self.check_unique(&self.sweep.angles_deg.values()?)?;
+        self.check_ladder()?;
         // Whether the workers fit in this machine's memory is checked where
         // they start (`memory::check_fits`), not here.
         for (key, spec) in self.cases()? {
@@ -655,6 +715,40 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// A ladder needs surfaces that can be sampled on any grid.
+    fn check_ladder(&self) -> Result<()> {
+        let levels = self.convergence.levels;
+        if !(1..=MAX_LEVELS).contains(&levels) {
+            bail!("convergence.levels = {levels}: must be 1 (no ladder) to {MAX_LEVELS}");
+        }
+        if levels > 1 {
+            if let Some(name) = self
+                .sweep
+                .surfaces
+                .iter()
+                .find(|s| self.surfaces.get(*s).is_some_and(|c| c.file.is_some()))
+            {
+                bail!("convergence.levels = {levels}: surface `{name}` is a height map, sampled on one grid only; ladders need surfaces defined by shape (or levels = 1)");
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid of ladder level `level` (level 0: `[grid]` itself).
+    pub fn level_grid(&self, level: usize) -> Grid {
+        let spacing = self.grid.spacing_um * 1e-6;
+        if level == 0 {
+            return Grid::square(self.grid.points, spacing);
+        }
+        let n = ladder_points(self.grid.points, level);
+        Grid::square(n, spacing * self.grid.points as f64 / n as f64)
+    }
+
+    /// Points per side of the finest grid the sweep solves on.
+    pub fn finest_points(&self) -> usize {
+        self.level_grid(self.convergence.levels - 1).n
     }
 
     /// Resolves a material name: `[materials.NAME]` first, then presets.
@@ -695,7 +789,7 @@ impl Config {
         CaseSpec {
             material,
             surface,
-            grid: Grid::square(self.grid.points, self.grid.spacing_um * 1e-6),
+            grid: self.level_grid(0),
             load: Load {
                 indenter_radius_m: self.indenter.radius_mm * 1e-3,
                 normal_force_n: self.load.normal_n,
@@ -714,8 +808,8 @@ impl Config {
         }
     }
 
-    /// All cases of the sweep in a fixed order: materials × surfaces × angles.
-    /// Each material and surface is resolved once.
+    /// All cases of the sweep in a fixed order: materials × surfaces × angles
+    /// (× ladder levels, finest last). Each material and surface is resolved once.
     pub fn cases(&self) -> Result<Vec<(CaseKey, CaseSpec)>> {
         let angles = self.sweep.angles_deg.values()?;
         let surfaces = self
@@ -730,7 +824,15 @@ impl Config {
             for (s, surface) in &surfaces {
                 for &a in &angles {
                     let spec = self.spec_of(material.clone(), surface.clone(), a);
-                    out.push((CaseKey::new(m, s, a), spec));
+                    for level in 1..self.convergence.levels {
+                        let finer = CaseSpec {
+                            grid: self.level_grid(level),
+                            ..spec.clone()
+                        };
+                        out.push((CaseKey::new(m, s, a).at_level(level), finer));
+                    }
+                    let at = out.len() + 1 - self.convergence.levels;
+                    out.insert(at, (CaseKey::new(m, s, a), spec));
                 }
             }
         }

@@ -26,18 +26,19 @@ fn human_seconds(s: f64) -> String {
 pub fn report(config: &Config, workers: usize) -> Result<String> {
     let cases = config.cases()?;
     anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
-    let n = config.grid.points;
+    // The finest ladder level sets the memory a worker needs.
+    let n = config.finest_points();
     let angles = config.sweep.angles_deg.values()?;
     // Kernels in first-use order, with whether the store holds them.
     let store = worker::kernel_store::FileStore::default_location()
         .map(worker::kernel_store::FileStore::new);
-    let mut kernels: BTreeMap<KernelKey, (String, bool, bool)> = BTreeMap::new();
+    let mut kernels: BTreeMap<KernelKey, (String, bool, bool, usize)> = BTreeMap::new();
     for (key, spec) in &cases {
         let persistent = spec.material.model().persist_tables();
         if let std::collections::btree_map::Entry::Vacant(slot) = kernels.entry(KernelKey::of(spec))
         {
             let cached = persistent && store.as_ref().is_some_and(|s| s.holds(slot.key()));
-            slot.insert((key.material.clone(), persistent, cached));
+            slot.insert((key.material.clone(), persistent, cached, spec.grid.n));
         }
     }
     let per_worker = crate::memory::worker_bytes(n, kernels.len());
@@ -48,12 +49,23 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         crate::memory::available_bytes(),
     )?;
     let mut s = String::new();
-    let mm = n as f64 * config.grid.spacing_um / 1000.0;
+    let n0 = config.grid.points;
+    let mm = n0 as f64 * config.grid.spacing_um / 1000.0;
     let _ = writeln!(
         s,
-        "grid:      {n} x {n} cells of {} µm ({mm:.2} mm square domain)",
+        "grid:      {n0} x {n0} cells of {} µm ({mm:.2} mm square domain)",
         config.grid.spacing_um
     );
+    let levels = config.convergence.levels;
+    if levels > 1 {
+        let sizes: Vec<String> = (0..levels)
+            .map(|k| {
+                let g = config.level_grid(k);
+                format!("{}² ({:.3} µm)", g.n, g.dx * 1e6)
+            })
+            .collect();
+        let _ = writeln!(s, "ladder:    {levels} levels: {}", sizes.join(", "));
+    }
     let list = |v: &[String]| v.join(", ");
     let _ = writeln!(
         s,
@@ -71,26 +83,26 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
     let _ = writeln!(
         s,
-        "cases:     {} = {} materials x {} surfaces x {} angles",
+        "cases:     {} = {} materials x {} surfaces x {} angles x {levels} level(s)",
         cases.len(),
         config.sweep.materials.len(),
         config.sweep.surfaces.len(),
         angles.len()
     );
-    let to_build = kernels.values().filter(|(_, _, cached)| !cached).count();
+    let to_build = kernels.values().filter(|(_, _, cached, _)| !cached).count();
     let _ = writeln!(
         s,
         "kernels:   {} ({to_build} to build, {} from the cache)",
         kernels.len(),
         kernels.len() - to_build
     );
-    for (material, persistent, cached) in kernels.values() {
+    for (material, persistent, cached, n) in kernels.values() {
         let what = match (persistent, cached) {
             (false, _) => "closed form, built each run",
             (true, true) => "anisotropic, in the kernel cache",
             (true, false) => "anisotropic, to build (then cached)",
         };
-        let _ = writeln!(s, "           {material}: {what}");
+        let _ = writeln!(s, "           {material} at {n}²: {what}");
     }
     let workers_used = workers.min(cases.len()).max(1);
     let _ = writeln!(
@@ -99,10 +111,15 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         per_worker / 1e6
     );
     let solving: f64 = cases.iter().map(|(_, spec)| case_seconds(spec)).sum();
-    let total = solving + to_build as f64 * kernel_seconds(n);
+    let total = solving
+        + kernels
+            .values()
+            .filter(|(_, _, cached, _)| !cached)
+            .map(|&(_, _, _, n)| kernel_seconds(n))
+            .sum::<f64>();
     let _ = writeln!(
         s,
-        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average at {n}²: the paper sweep's measured means per kind of case at 384², scaled as N^2.5; a guide within a factor of 2)",
+        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^2.5; a guide within a factor of 2)",
         human_seconds(total / workers_used as f64),
         solving / cases.len() as f64
     );

@@ -8,6 +8,7 @@
 pub mod atomic;
 pub mod case;
 pub mod config;
+pub mod convergence;
 pub mod cost;
 pub mod dry_run;
 pub mod maps;

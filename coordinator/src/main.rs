@@ -46,6 +46,10 @@ enum Cmd {
         /// Check everything and print what the sweep would do; solve nothing, write nothing.
         #[arg(long)]
         dry_run: bool,
+        /// Solve every case on L grids of the same domain (cell sizes h,
+        /// h/√2, h/2, …) and report μa with an error bar (= --set convergence.levels=L).
+        #[arg(long, value_name = "L")]
+        refine: Option<usize>,
         /// Run only shard K of N (0-based), e.g. 0/4; `slurm` reads
         /// SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT. Merge with `mpcontact merge`.
         #[arg(long)]
@@ -70,6 +74,9 @@ enum Cmd {
         /// Override one config key.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
+        /// As `run --refine L`: a convergence ladder of L grids.
+        #[arg(long, value_name = "L")]
+        refine: Option<usize>,
     },
     /// Solve one case in-process and write case.json and the fields.
     Solve {
@@ -209,6 +216,11 @@ fn worker_exe() -> Result<PathBuf> {
     std::env::current_exe().context("cannot locate the mpcontact executable")
 }
 
+/// `--refine L` is `--set convergence.levels=L` (one place for the key).
+fn refine_set(refine: Option<usize>) -> Option<String> {
+    refine.map(|levels| format!("convergence.levels={levels}"))
+}
+
 fn real_main() -> Result<()> {
     match Cli::parse().cmd {
         Cmd::Run {
@@ -218,10 +230,12 @@ fn real_main() -> Result<()> {
             resume,
             quiet,
             save_fields,
-            sets,
+            mut sets,
             dry_run,
+            refine,
             shard,
         } => {
+            sets.extend(refine_set(refine));
             let shard = shard
                 .as_deref()
                 .map(coordinator::shard::Shard::parse)
@@ -265,13 +279,14 @@ fn real_main() -> Result<()> {
                 },
             )?;
             println!(
-                "a = {:.6e} m, c = {:.6e} m, δz = {:.6e} m, δt = {:.6e} m, p_max = {:.6e} Pa, μa = {}, converged = {} → {}",
+                "a = {:.6e} m, c = {:.6e} m, δz = {:.6e} m, δt = {:.6e} m, p_max = {:.6e} Pa, μa = {} (paper's whole-cell radii: {}), converged = {} → {}",
                 s.contact_radius_m,
                 s.stick_radius_m,
                 s.delta_z_m,
                 s.delta_t_m,
                 s.p_max_pa,
                 s.mu_a.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
+                s.mu_a_cells.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
                 s.converged,
                 out.join("case.json").display()
             );
@@ -293,8 +308,10 @@ fn real_main() -> Result<()> {
         Cmd::Check {
             config,
             workers,
-            sets,
+            mut sets,
+            refine,
         } => {
+            sets.extend(refine_set(refine));
             let cfg = Config::load(&config, &sets)?;
             print!("{}", check_report(&config, &cfg, worker_count(workers)?)?);
             Ok(())

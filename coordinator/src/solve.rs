@@ -20,6 +20,7 @@ struct CaseJson<'a> {
     #[serde(flatten)]
     scalars: &'a CaseScalars,
     apparent_radius_definition: &'static str,
+    apparent_radius_definition_cells: &'static str,
     grid_points: usize,
     spacing_m: f64,
     spec: &'a CaseSpec,
@@ -79,6 +80,7 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         status: Status::of_solved(scalars.converged),
         scalars: &scalars,
         apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
+        apparent_radius_definition_cells: solver::APPARENT_RADIUS_DEFINITION_CELLS,
         grid_points: spec.grid.n,
         spacing_m: spec.grid.dx,
         spec: &spec,

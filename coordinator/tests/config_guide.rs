@@ -70,6 +70,8 @@ fn accepted_keys() -> BTreeSet<String> {
     c.run = RunCfg {
         case_timeout_s: 5.0,
     };
+    // Non-default, so that the echo holds the section.
+    c.convergence = coordinator::config::ConvergenceCfg { levels: 3 };
     let v = toml::Value::try_from(&c).unwrap();
     let mut keys = BTreeSet::new();
     walk("", &v, &mut keys);

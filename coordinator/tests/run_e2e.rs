@@ -974,3 +974,79 @@ fn shards_merge_into_the_single_run_and_bad_merges_are_refused() {
     check_ok(&c.output().unwrap(), "shard of another config");
     refused(&all, "come from different configs");
 }
+
+/// Issue #15: `--refine 3` solves one patterned case on three grids of the
+/// same domain and reports μa per level, its estimate and error bar, formed
+/// as `convergence::estimate` forms them from the per-level rows.
+#[test]
+fn a_refine_ladder_reports_levels_estimate_and_error() {
+    let dir = scratch("ladder");
+    let mut cmd = sweep_cmd(&dir, "out", 2, "l");
+    cmd.args([
+        "--refine",
+        "3",
+        "--set",
+        "sweep.materials=[\"Cu\"]",
+        "--set",
+        "sweep.surfaces=[\"circle-B\"]",
+        "--set",
+        "sweep.angles_deg=[45.0]",
+    ]);
+    check_ok(&cmd.output().unwrap(), "ladder sweep");
+    let o = dir.join("out");
+    let rows = read_csv(&o.join("results.csv"));
+    let col = |name: &str| rows[0].iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len() - 1, 3, "one case on three levels");
+    let mut levels: Vec<(usize, usize, f64, f64)> = rows[1..]
+        .iter()
+        .map(|r| {
+            assert_eq!(r[col("status")], "ok", "{r:?}");
+            (
+                r[col("level")].parse().unwrap(),
+                r[col("grid_points")].parse().unwrap(),
+                r[col("spacing_m")].parse().unwrap(),
+                r[col("mu_a")].parse().unwrap(),
+            )
+        })
+        .collect();
+    levels.sort_by_key(|l| l.0);
+    // 32, 45 (the 5-smooth size nearest 32√2), 64 cells on one domain.
+    assert_eq!(
+        levels.iter().map(|l| l.1).collect::<Vec<_>>(),
+        vec![32, 45, 64]
+    );
+    for l in &levels {
+        assert!(
+            (l.1 as f64 * l.2 / 6.4e-3 - 1.0).abs() < 1e-12,
+            "domain kept: {l:?}"
+        );
+    }
+    let curves = read_csv(&o.join("curves.csv"));
+    assert_eq!(curves.len(), 2, "one curve point");
+    let c = &curves[1];
+    let ccol = |name: &str| curves[0].iter().position(|h| h == name).unwrap();
+    let by_level: Vec<f64> = c[ccol("mu_a_by_level")]
+        .split(';')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(by_level, levels.iter().map(|l| l.3).collect::<Vec<_>>());
+    let want =
+        coordinator::convergence::estimate(&levels.iter().map(|l| (l.2, l.3)).collect::<Vec<_>>())
+            .unwrap();
+    assert_eq!(c[ccol("mu_a")].parse::<f64>().unwrap(), want.value);
+    assert_eq!(
+        c[ccol("mu_a_err")].parse::<f64>().unwrap(),
+        want.err.unwrap()
+    );
+    assert_eq!(c[ccol("method")], want.method.as_str());
+    assert!(want.err.unwrap() > 0.0);
+    // Richardson only with an observed order; a spread is the finest value.
+    match want.method {
+        coordinator::convergence::Method::Richardson => assert!(want.order.is_some()),
+        _ => assert_eq!(want.value, levels[2].3),
+    }
+    let s = summary(&o);
+    assert_eq!(s["convergence_levels"], 3);
+    assert_eq!(s["curves"]["Cu / circle-B"]["points"], 1);
+    assert!(o.join("mu_a_vs_angle.png").exists());
+}

@@ -68,7 +68,8 @@ pub use operator::{Operator, Spectra};
 pub use progress::{set_tick_hook, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
-    APPARENT_RADIUS_DEFINITION, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+    APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS, K_E_DEFINITION,
+    K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
 pub use spec::{CaseSpec, Load, Numerics, MAX_GRID_POINTS};
 pub use surface::{Island, LatticeKind, Surface};

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::ContactState;
 use crate::error::SolverError;
-use crate::geometry::{equivalent_radius, hull_area};
+use crate::geometry::{equivalent_radius, hull_area, subcell_hull_area};
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
 use crate::spec::{CaseSpec, Load};
@@ -16,10 +16,19 @@ use crate::tangential::{TangentialReport, TangentialSolution};
 /// The scalars of one solved case.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CaseScalars {
-    /// Apparent contact radius: circle with the area of the convex hull of the contact cells, m.
+    /// Apparent contact radius a: circle with the area of the convex hull of
+    /// the contact boundary located between cell centres
+    /// ([`APPARENT_RADIUS_DEFINITION`]), m. Used for μa and K_E.
     pub contact_radius_m: f64,
-    /// Apparent stick radius: same for the stick cells, m.
+    /// Apparent stick radius c: same for the stick zone, m.
     pub stick_radius_m: f64,
+    /// The paper's a: circle with the area of the convex hull of the contact
+    /// cells, each taken as its full square ([`APPARENT_RADIUS_DEFINITION_CELLS`]), m.
+    #[serde(default)]
+    pub contact_radius_cells_m: f64,
+    /// The paper's c: same for the stick cells, m.
+    #[serde(default)]
+    pub stick_radius_cells_m: f64,
     /// Rigid tangential shift δt projected on the force direction, m.
     pub delta_t_m: f64,
     /// Component of δt perpendicular to the force (left of it), m.
@@ -36,10 +45,17 @@ pub struct CaseScalars {
     pub stick_area_m2: f64,
     /// True when any contact cell lies off the island tops (patterned surfaces).
     pub base_contact: bool,
-    /// Apparent friction coefficient from Eq. 19 (None without tangential load).
+    /// Apparent friction coefficient from Eq. 19 with a and c (None without tangential load).
     pub mu_a: Option<f64>,
     /// K_E used for μa, Pa.
     pub k_e: f64,
+    /// μa from Eq. 19 with the paper's radii (`*_cells_m`) and `k_e_cells`.
+    #[serde(default)]
+    pub mu_a_cells: Option<f64>,
+    /// K_E used for `mu_a_cells` (differs from `k_e` only when calibrated on
+    /// the flat surface, with the paper's radii), Pa.
+    #[serde(default)]
+    pub k_e_cells: f64,
     /// Where K_E came from: "isotropic" (formula with E, ν) or "flat-calibrated".
     pub k_e_source: String,
     /// Hertz contact radius with the isotropic-equivalent constants, m.
@@ -123,9 +139,14 @@ pub struct CaseOutput {
     pub fields: Fields,
 }
 
-/// How the apparent radii a and c of every result are defined.
-pub const APPARENT_RADIUS_DEFINITION: &str =
-    "radius of the circle with the area of the convex hull of the contact (stick) cells, each cell taken as its full square";
+/// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
+/// used for `mu_a` and `k_e`) are defined.
+pub const APPARENT_RADIUS_DEFINITION: &str = "radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres: along every row and column, the zero of p^2 ((mu p - |q|)^2 for stick) extrapolated linearly outward from the two outermost cells, kept within one cell pitch (the cell face where the level does not fall outward)";
+
+/// How the paper's radii (`contact_radius_cells_m`, `stick_radius_cells_m`,
+/// used for `mu_a_cells` and `k_e_cells`) are defined.
+pub const APPARENT_RADIUS_DEFINITION_CELLS: &str =
+    "radius of the circle with the area of the convex hull of the contact (stick) cells, each cell taken as its full square (the paper's definition)";
 
 /// How K_E in μa is obtained.
 pub const K_E_DEFINITION: &str = "isotropic: K_E = 8E/(3(1+nu)(2-nu)) (paper Eq. 19); anisotropic: K_E(psi) = mu P (a^2 - c^2)/(delta_F a^3) calibrated on the flat surface of the same material at the same force angle";
@@ -135,16 +156,43 @@ pub const K_E_ISOTROPIC: &str = "isotropic";
 /// `k_e_source` of a K_E calibrated on the flat surface.
 pub const K_E_FLAT_CALIBRATED: &str = "flat-calibrated";
 
-/// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)).
-pub fn mu_apparent(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> f64 {
-    let (a, c) = (s.contact_radius_m, s.stick_radius_m);
-    s.delta_t_m * a.powi(3) * k_e / (normal_force_n * (a * a - c * c))
+/// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)), with the radii `[a, c]`.
+fn eq19(delta_t: f64, [a, c]: [f64; 2], normal_force_n: f64, k_e: f64) -> f64 {
+    delta_t * a.powi(3) * k_e / (normal_force_n * (a * a - c * c))
 }
 
-/// K_E calibrated from a flat-surface case so that Eq. 19 returns μ there.
+/// Eq. 19 solved for K_E so that it returns `friction`.
+fn eq19_k_e(delta_t: f64, [a, c]: [f64; 2], normal_force_n: f64, friction: f64) -> f64 {
+    friction * normal_force_n * (a * a - c * c) / (delta_t * a.powi(3))
+}
+
+impl CaseScalars {
+    /// a and c ([`APPARENT_RADIUS_DEFINITION`]).
+    pub fn radii(&self) -> [f64; 2] {
+        [self.contact_radius_m, self.stick_radius_m]
+    }
+
+    /// The paper's a and c ([`APPARENT_RADIUS_DEFINITION_CELLS`]).
+    pub fn radii_cells(&self) -> [f64; 2] {
+        [self.contact_radius_cells_m, self.stick_radius_cells_m]
+    }
+}
+
+/// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)), with a and c.
+pub fn mu_apparent(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> f64 {
+    eq19(s.delta_t_m, s.radii(), normal_force_n, k_e)
+}
+
+/// K_E calibrated from a flat-surface case so that Eq. 19 (with a and c)
+/// returns μ there.
 pub fn calibrate_k_e(flat: &CaseScalars, friction: f64, normal_force_n: f64) -> f64 {
-    let (a, c) = (flat.contact_radius_m, flat.stick_radius_m);
-    friction * normal_force_n * (a * a - c * c) / (flat.delta_t_m * a.powi(3))
+    eq19_k_e(flat.delta_t_m, flat.radii(), normal_force_n, friction)
+}
+
+/// μa from Eq. 19 with the paper's radii, when they leave a slip annulus.
+fn mu_apparent_cells(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> Option<f64> {
+    let [a, c] = s.radii_cells();
+    (c < a).then(|| eq19(s.delta_t_m, [a, c], normal_force_n, k_e))
 }
 
 /// The μa of a case of an anisotropic material: K_E(ψ) calibrated on the
@@ -157,6 +205,15 @@ pub fn calibrate_on_flat(s: &mut CaseScalars, flat: &CaseScalars, load: &Load) {
     s.k_e = k_e;
     s.k_e_source = K_E_FLAT_CALIBRATED.into();
     s.mu_a = Some(mu_apparent(s, load.normal_force_n, k_e));
+    // Each definition is calibrated with its own radii, so that both return
+    // μ on the flat surface.
+    s.k_e_cells = eq19_k_e(
+        flat.delta_t_m,
+        flat.radii_cells(),
+        load.normal_force_n,
+        load.friction,
+    );
+    s.mu_a_cells = mu_apparent_cells(s, load.normal_force_n, s.k_e_cells);
 }
 
 /// Smallest apparent contact or stick radius reported, in cells.
@@ -208,6 +265,8 @@ pub(crate) fn reduce(
     let stick_in_contact: Vec<bool> = (0..len).map(|i| contact[i] && stick[i]).collect();
     let contact_area = contact.iter().filter(|&&b| b).count() as f64 * da;
     let stick_area = stick_in_contact.iter().filter(|&&b| b).count() as f64 * da;
+    // The paper's radii (whole cells) decide what the grid resolves, as
+    // before the sub-cell radii existed; the two differ by less than a cell.
     let a = equivalent_radius(hull_area(&grid, &contact));
     let c = if fnorm > 0.0 {
         equivalent_radius(hull_area(&grid, &stick_in_contact))
@@ -247,9 +306,28 @@ pub(crate) fn reduce(
     let eq = spec.material.equivalent;
     let hertz_radius =
         (3.0 * load * spec.load.indenter_radius_m / (4.0 * eq.plane_strain())).cbrt();
+    // Sub-cell radii: p falls to zero like the root of the distance at a
+    // Hertzian edge, and μp − |q| does at a Mindlin stick edge.
+    let friction = spec.load.friction;
+    let a_sub = equivalent_radius(subcell_hull_area(&grid, &contact, &p, &heights));
+    let c_sub = if fnorm > 0.0 {
+        let reserve: Vec<f64> = (0..len)
+            .map(|i| (friction * p[i] - qx[i].hypot(qy[i])).max(0.0))
+            .collect();
+        equivalent_radius(subcell_hull_area(
+            &grid,
+            &stick_in_contact,
+            &reserve,
+            &heights,
+        ))
+    } else {
+        a_sub
+    };
     let mut s = CaseScalars {
-        contact_radius_m: a,
-        stick_radius_m: c,
+        contact_radius_m: a_sub,
+        stick_radius_m: c_sub,
+        contact_radius_cells_m: a,
+        stick_radius_cells_m: c,
         delta_t_m: shift[0] * dir[0] + shift[1] * dir[1],
         delta_t_perp_m: -shift[0] * dir[1] + shift[1] * dir[0],
         delta_z_m: approach,
@@ -260,6 +338,8 @@ pub(crate) fn reduce(
         base_contact,
         mu_a: None,
         k_e: eq.mindlin_k_e(),
+        mu_a_cells: None,
+        k_e_cells: eq.mindlin_k_e(),
         k_e_source: K_E_ISOTROPIC.into(),
         hertz_radius_m: hertz_radius,
         hertz_pressure_pa: 3.0 * load / (2.0 * std::f64::consts::PI * hertz_radius * hertz_radius),
@@ -293,7 +373,15 @@ pub(crate) fn reduce(
                 },
             });
         }
+        if c_sub >= a_sub {
+            return Err(SolverError::SlipUnresolved {
+                detail: format!(
+                    "the stick zone's boundary reaches the contact boundary, c = a = {a_sub:.4e} m"
+                ),
+            });
+        }
         s.mu_a = Some(mu_apparent(&s, load, s.k_e));
+        s.mu_a_cells = mu_apparent_cells(&s, load, s.k_e_cells);
     }
     let fields = Fields {
         n,

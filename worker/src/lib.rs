@@ -56,6 +56,10 @@ impl CheckFinite for WireScalars {
             ("stick_area_m2", s.stick_area_m2),
             ("k_e", s.k_e),
             ("mu_a", s.mu_a.unwrap_or(0.0)),
+            ("contact_radius_cells_m", s.contact_radius_cells_m),
+            ("stick_radius_cells_m", s.stick_radius_cells_m),
+            ("k_e_cells", s.k_e_cells),
+            ("mu_a_cells", s.mu_a_cells.unwrap_or(0.0)),
         ];
         named
             .iter()

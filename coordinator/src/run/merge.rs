@@ -189,8 +189,6 @@ pub fn merge_shards(dirs: &[PathBuf], out_dir: &Path) -> anyhow::Result<RunSumma
         run_id: format!("merge of {count} shards"),
         out_dir: out_dir.to_path_buf(),
         total: plan.cases.len(),
-        apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
-        k_e_definition: solver::K_E_DEFINITION,
         ..Default::default()
     };
     summary.tally(&plan.cases, &outcomes);

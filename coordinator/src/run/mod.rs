@@ -108,7 +108,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
     crate::memory::check_fits(
         "the sweep",
-        crate::memory::worker_bytes(args.config.grid.points, kernels.len()),
+        crate::memory::worker_bytes(args.config.finest_points(), kernels.len()),
         args.workers,
         crate::memory::available_bytes(),
     )?;
@@ -128,8 +128,6 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         resumed: resumed.cases,
         workers: args.workers,
         started_unix_s,
-        apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
-        k_e_definition: solver::K_E_DEFINITION,
         ..Default::default()
     };
 
@@ -232,10 +230,18 @@ fn write_outputs(
     let rows = output::calibrate(cases, outcomes);
     let write = |name: &str, text: String| crate::atomic::write(&dir.join(name), text.as_bytes());
     write("results.csv", output::results_csv(&rows))?;
-    write("curves.csv", output::curves_csv(&rows))?;
-    let curves = output::curves(&rows);
+    let levels = cases.iter().map(|c| c.key.level + 1).max().unwrap_or(1);
+    let (points, incomplete) = output::curve_points(&rows, levels);
+    write("curves.csv", output::curves_csv(&points))?;
+    summary.apparent_radius_definition = solver::APPARENT_RADIUS_DEFINITION;
+    summary.apparent_radius_definition_cells = solver::APPARENT_RADIUS_DEFINITION_CELLS;
+    summary.k_e_definition = solver::K_E_DEFINITION;
+    summary.error_estimate = crate::convergence::ERROR_ESTIMATE;
+    summary.convergence_levels = levels;
+    summary.incomplete_points = incomplete;
+    summary.curves = output::curve_summaries(&points);
     for name in ["mu_a_vs_angle.png", "mu_a_vs_angle.svg"] {
-        if let Err(e) = output::plot_curves(&dir.join(name), &curves) {
+        if let Err(e) = output::plot_curves(&dir.join(name), &points) {
             summary.output_warnings.push(format!("{name}: {e:#}"));
         }
     }

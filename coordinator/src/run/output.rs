@@ -9,17 +9,20 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use serde::Serialize;
 use solver::{calibrate_on_flat, CaseScalars};
 
 use super::journal::Outcome;
 use super::plan::PlannedCase;
 use crate::case::{CaseKey, Status};
+use crate::convergence::{estimate, Estimate};
 
 /// Header of `results.csv` (one row per case, see README.md). Users' tools
 /// read these names: change one only with a reason in the docs.
-pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker";
+pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker,level,grid_points,spacing_m,mu_a_cells,k_e_cells,contact_radius_cells_m,stick_radius_cells_m";
 /// Header of `curves.csv`.
-pub const CURVES_HEADER: &str = "material,surface,angle_deg,mu_a";
+pub const CURVES_HEADER: &str =
+    "material,surface,angle_deg,mu_a,mu_a_err,k_e,k_e_err,method,order,mu_a_by_level,mu_a_cells";
 
 /// A finished case ready for output: its plan entry, its record and the
 /// scalars after K_E calibration.
@@ -94,7 +97,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
             csv_field(&c.key.material),
             csv_field(&c.key.surface),
             fmt_f64(c.spec.load.angle_deg),
@@ -112,7 +115,14 @@ pub fn results_csv(rows: &[Row]) -> String {
             i(|s| s.tangential_iterations),
             i(|s| s.coupling_iterations),
             r.record.seconds,
-            r.record.worker
+            r.record.worker,
+            c.key.level,
+            c.spec.grid.n,
+            fmt_f64(c.spec.grid.dx),
+            opt(s.and_then(|s| s.mu_a_cells)),
+            f(|s| s.k_e_cells),
+            f(|s| s.contact_radius_cells_m),
+            f(|s| s.stick_radius_cells_m),
         );
     }
     out
@@ -126,38 +136,153 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// Rows that belong on a curve: solved, converged, with a μa.
-pub fn curve_points<'a>(rows: &'a [Row]) -> Vec<(&'a Row<'a>, f64)> {
-    rows.iter()
-        .filter(|r| r.record.status == Status::Ok)
-        .filter_map(|r| r.scalars.as_ref().and_then(|s| s.mu_a).map(|m| (r, m)))
-        .collect()
+/// One point of a μa-versus-angle curve: a material × surface × angle,
+/// from every level of its ladder (one level without a ladder).
+#[derive(Clone, Debug)]
+pub struct CurvePoint {
+    /// The point's key (level 0).
+    pub key: CaseKey,
+    /// μa: best value and error bar over the levels.
+    pub mu_a: Estimate,
+    /// K_E: the same.
+    pub k_e: Estimate,
+    /// μa on each level, coarsest first.
+    pub mu_a_by_level: Vec<f64>,
+    /// μa with the paper's radii on the finest level.
+    pub mu_a_cells: Option<f64>,
+    /// A flat-surface case whose K_E was calibrated on itself (anisotropic
+    /// material): its K_E(ψ) is the calibration curve.
+    pub flat_calibration: bool,
+}
+
+/// The curve points of `rows`: each material × surface × angle whose
+/// `levels` cases all solved, converged and have a μa. The second value
+/// counts the points left out because a level did not.
+pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
+    let mut by_point: BTreeMap<String, (CaseKey, Vec<&Row>)> = BTreeMap::new();
+    for r in rows {
+        let key = r.case.key.point();
+        by_point
+            .entry(key.to_string())
+            .or_insert_with(|| (key, Vec::new()))
+            .1
+            .push(r);
+    }
+    let (mut points, mut incomplete) = (Vec::new(), 0);
+    for (_, (key, mut rs)) in by_point {
+        rs.sort_by_key(|r| r.case.key.level);
+        let solved: Vec<(f64, &CaseScalars, f64)> = rs
+            .iter()
+            .filter(|r| r.record.status == Status::Ok)
+            .filter_map(|r| {
+                let s = r.scalars.as_ref()?;
+                Some((r.case.spec.grid.dx, s, s.mu_a?))
+            })
+            .collect();
+        if solved.len() != levels {
+            incomplete += 1;
+            continue;
+        }
+        let series = |g: &dyn Fn(&CaseScalars) -> f64| -> Vec<(f64, f64)> {
+            solved.iter().map(|&(h, s, _)| (h, g(s))).collect()
+        };
+        let (Some(mu_a), Some(k_e)) = (
+            estimate(&series(&|s| s.mu_a.unwrap_or(f64::NAN))),
+            estimate(&series(&|s| s.k_e)),
+        ) else {
+            continue;
+        };
+        points.push(CurvePoint {
+            key,
+            mu_a,
+            k_e,
+            mu_a_by_level: solved.iter().map(|p| p.2).collect(),
+            mu_a_cells: solved.last().and_then(|p| p.1.mu_a_cells),
+            flat_calibration: rs[0].case.spec.surface == solver::Surface::Flat
+                && solved[0].1.k_e_source == solver::K_E_FLAT_CALIBRATED,
+        });
+    }
+    (points, incomplete)
 }
 
 /// Text of `curves.csv`.
-pub fn curves_csv(rows: &[Row]) -> String {
+pub fn curves_csv(points: &[CurvePoint]) -> String {
     let mut out = String::from(CURVES_HEADER);
     out.push('\n');
-    for (r, mu) in curve_points(rows) {
+    for p in points {
+        let by_level: Vec<String> = p.mu_a_by_level.iter().map(|&v| fmt_f64(v)).collect();
         let _ = writeln!(
             out,
-            "{},{},{},{}",
-            csv_field(&r.case.key.material),
-            csv_field(&r.case.key.surface),
-            fmt_f64(r.case.spec.load.angle_deg),
-            fmt_f64(mu)
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&p.key.material),
+            csv_field(&p.key.surface),
+            fmt_f64(p.key.angle_deg),
+            fmt_f64(p.mu_a.value),
+            opt(p.mu_a.err),
+            fmt_f64(p.k_e.value),
+            opt(p.k_e.err),
+            p.mu_a.method.as_str(),
+            opt(p.mu_a.order),
+            by_level.join(";"),
+            opt(p.mu_a_cells),
         );
     }
     out
 }
 
-/// Curves keyed by "material / surface": (angle, μa) sorted by angle.
-pub fn curves(rows: &[Row]) -> BTreeMap<String, Vec<(f64, f64)>> {
-    let mut m: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
-    for (r, mu) in curve_points(rows) {
-        m.entry(format!("{} / {}", r.case.key.material, r.case.key.surface))
+/// What `summary.json` says of one material × surface curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct CurveSummary {
+    /// Points on the curve.
+    pub points: usize,
+    /// Smallest and largest μa over angle.
+    pub mu_a_min: f64,
+    /// See `mu_a_min`.
+    pub mu_a_max: f64,
+    /// Largest error bar on the curve (None without a ladder).
+    pub mu_a_err_max: Option<f64>,
+    /// Whether μa varies with the angle beyond its error: max − min exceeds
+    /// the sum of the error bars at the two extremes (None without a ladder
+    /// or with one angle).
+    pub resolved: Option<bool>,
+}
+
+/// Per material × surface ("material / surface"): range of μa over angle,
+/// its error and whether the variation is resolved.
+pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> {
+    let mut out = BTreeMap::new();
+    for (name, pts) in curves(points) {
+        let lo = pts.iter().min_by(|a, b| a.1.total_cmp(&b.1));
+        let hi = pts.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+        let (Some(lo), Some(hi)) = (lo, hi) else {
+            continue;
+        };
+        let errs: Option<Vec<f64>> = pts.iter().map(|p| p.2).collect();
+        let resolved = match (lo.2, hi.2) {
+            (Some(el), Some(eh)) if pts.len() > 1 => Some(hi.1 - lo.1 > el + eh),
+            _ => None,
+        };
+        out.insert(
+            name,
+            CurveSummary {
+                points: pts.len(),
+                mu_a_min: lo.1,
+                mu_a_max: hi.1,
+                mu_a_err_max: errs.map(|e| e.into_iter().fold(0.0, f64::max)),
+                resolved,
+            },
+        );
+    }
+    out
+}
+
+/// Curves keyed by "material / surface": (angle, μa, error) sorted by angle.
+pub fn curves(points: &[CurvePoint]) -> BTreeMap<String, Vec<(f64, f64, Option<f64>)>> {
+    let mut m: BTreeMap<String, Vec<(f64, f64, Option<f64>)>> = BTreeMap::new();
+    for p in points {
+        m.entry(format!("{} / {}", p.key.material, p.key.surface))
             .or_default()
-            .push((r.case.spec.load.angle_deg, mu));
+            .push((p.key.angle_deg, p.mu_a.value, p.mu_a.err));
     }
     for v in m.values_mut() {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -165,86 +290,239 @@ pub fn curves(rows: &[Row]) -> BTreeMap<String, Vec<(f64, f64)>> {
     m
 }
 
-/// Draw μa versus angle, one line per material × surface, to `path`
-/// (PNG or SVG by extension).
-pub fn plot_curves(path: &Path, curves: &BTreeMap<String, Vec<(f64, f64)>>) -> anyhow::Result<()> {
-    use plotters::prelude::*;
+/// One panel of the sweep's figure: named series of (angle, value, error).
+struct Panel {
+    title: String,
+    y_desc: &'static str,
+    series: BTreeMap<String, Vec<(f64, f64, Option<f64>)>>,
+}
+
+/// Draw μa versus angle to `path` (PNG or SVG by extension): one panel per
+/// material, one series per surface with markers at the computed angles
+/// and error bars where a ladder gave them, the flat surface in black; and,
+/// when a material's K_E was calibrated on its flat surface, a panel of
+/// K_E(ψ) (GPa) for those materials. The legend sits beside the panels.
+pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
+    let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
+    let mut k_e = Panel {
+        title: "K_E(ψ), flat-surface calibration".into(),
+        y_desc: "K_E (GPa)",
+        series: BTreeMap::new(),
+    };
+    for p in points {
+        let (x, mu) = (p.key.angle_deg, &p.mu_a);
+        by_material
+            .entry(p.key.material.as_str())
+            .or_insert_with(|| Panel {
+                title: p.key.material.clone(),
+                y_desc: "apparent friction μa (–)",
+                series: BTreeMap::new(),
+            })
+            .series
+            .entry(p.key.surface.clone())
+            .or_default()
+            .push((x, mu.value, mu.err));
+        if p.flat_calibration {
+            k_e.series.entry(p.key.material.clone()).or_default().push((
+                x,
+                p.k_e.value / 1e9,
+                p.k_e.err.map(|e| e / 1e9),
+            ));
+        }
+    }
+    let mut panels: Vec<Panel> = by_material.into_values().collect();
+    if !k_e.series.is_empty() {
+        panels.push(k_e);
+    }
+    for series in panels.iter_mut().flat_map(|p| p.series.values_mut()) {
+        series.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let cols = panels.len().clamp(1, 2);
+    let rows = panels.len().div_ceil(2).max(1);
+    let size = (560 * cols as u32 + 180, 400 * rows as u32);
     let is_svg = path.extension().is_some_and(|e| e == "svg");
-    fn draw<DB: DrawingBackend>(
-        root: DrawingArea<DB, plotters::coord::Shift>,
-        curves: &BTreeMap<String, Vec<(f64, f64)>>,
-    ) -> anyhow::Result<()>
-    where
-        DB::ErrorType: 'static,
-    {
-        let pts = curves.values().flatten();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        let (mut xlo, mut xhi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &(a, m) in pts {
-            lo = lo.min(m);
-            hi = hi.max(m);
-            xlo = xlo.min(a);
-            xhi = xhi.max(a);
+    crate::atomic::replace_with(path, |tmp| {
+        if is_svg {
+            draw_panels(
+                SVGBackend::new(tmp, size).into_drawing_area(),
+                &panels,
+                cols,
+            )
+        } else {
+            draw_panels(
+                BitMapBackend::new(tmp, size).into_drawing_area(),
+                &panels,
+                cols,
+            )
+        }
+    })
+}
+
+use plotters::prelude::*;
+
+fn draw_panels<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    panels: &[Panel],
+    cols: usize,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+    root.fill(&WHITE).map_err(e)?;
+    // One colour and marker per series name, the same in every panel; flat black.
+    let names: Vec<&str> = {
+        let mut v: Vec<&str> = panels
+            .iter()
+            .flat_map(|p| p.series.keys().map(String::as_str))
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    };
+    let style_of = |name: &str| -> (RGBAColor, usize) {
+        let k = names.iter().position(|s| *s == name).unwrap_or(0);
+        // Distinct, print-safe colours (no yellow on white).
+        const COLOURS: [(u8, u8, u8); 8] = [
+            (31, 119, 180),
+            (214, 39, 40),
+            (44, 160, 44),
+            (255, 127, 14),
+            (148, 103, 189),
+            (140, 86, 75),
+            (227, 119, 194),
+            (23, 190, 207),
+        ];
+        if name == "flat" {
+            (BLACK.to_rgba(), 0)
+        } else {
+            let (r, g, b) = COLOURS[k % COLOURS.len()];
+            (RGBColor(r, g, b).to_rgba(), k % 3)
+        }
+    };
+    let (plot_area, legend_area) = root.split_horizontally(root.dim_in_pixel().0 - 180);
+    let rows = panels.len().div_ceil(cols).max(1);
+    let areas = plot_area.split_evenly((rows, cols));
+    for (panel, area) in panels.iter().zip(areas.iter()) {
+        let (mut lo, mut hi, mut xlo, mut xhi) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y, err) in panel.series.values().flatten() {
+            let err = err.unwrap_or(0.0);
+            lo = lo.min(y - err);
+            hi = hi.max(y + err);
+            xlo = xlo.min(x);
+            xhi = xhi.max(x);
         }
         if !lo.is_finite() {
             (lo, hi, xlo, xhi) = (0.0, 1.0, 0.0, 180.0);
         }
-        let pad = ((hi - lo) * 0.1).max(1e-3);
+        let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1.0));
         if xhi <= xlo {
-            xhi = xlo + 1.0;
+            (xlo, xhi) = (xlo - 1.0, xhi + 1.0);
         }
-        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption("apparent friction vs force angle", ("sans-serif", 22))
-            .margin(12)
+        let xpad = (xhi - xlo) * 0.03;
+        let mut chart = ChartBuilder::on(area)
+            .caption(&panel.title, ("sans-serif", 20))
+            .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(xlo..xhi, (lo - pad)..(hi + pad))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+            .build_cartesian_2d((xlo - xpad)..(xhi + xpad), (lo - pad)..(hi + pad))
+            .map_err(e)?;
         chart
             .configure_mesh()
             .x_desc("force angle ψ (deg)")
-            .y_desc("μa")
+            .y_desc(panel.y_desc)
+            .x_label_formatter(&|x| format!("{x:.0}"))
             .draw()
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        for (k, (name, pts)) in curves.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
+            .map_err(e)?;
+        for (name, pts) in &panel.series {
+            let (color, marker) = style_of(name);
+            let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();
             chart
-                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
-                .map_err(|e| anyhow::anyhow!("{e:?}"))?
-                .label(name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                .draw_series(LineSeries::new(line.iter().copied(), color.stroke_width(2)))
+                .map_err(e)?;
+            let style = color.filled();
+            match marker {
+                0 => chart
+                    .draw_series(line.iter().map(|&c| Circle::new(c, 4, style)))
+                    .map(|_| ()),
+                1 => chart
+                    .draw_series(line.iter().map(|&c| TriangleMarker::new(c, 5, style)))
+                    .map(|_| ()),
+                _ => chart
+                    .draw_series(
+                        line.iter()
+                            .map(|&c| Cross::new(c, 5, color.stroke_width(2))),
+                    )
+                    .map(|_| ()),
+            }
+            .map_err(e)?;
+            chart
+                .draw_series(pts.iter().filter_map(|&(x, y, err)| {
+                    let err = err.filter(|&v| v > 0.0)?;
+                    Some(ErrorBar::new_vertical(
+                        x,
+                        y - err,
+                        y,
+                        y + err,
+                        color.stroke_width(1),
+                        6,
+                    ))
+                }))
+                .map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        Ok(())
     }
-    crate::atomic::replace_with(path, |tmp| {
-        if is_svg {
-            draw(SVGBackend::new(tmp, (900, 600)).into_drawing_area(), curves)
-        } else {
-            draw(
-                BitMapBackend::new(tmp, (900, 600)).into_drawing_area(),
-                curves,
-            )
+    // The legend beside the panels, never over the data.
+    for (k, name) in names.iter().enumerate() {
+        let (color, marker) = style_of(name);
+        let y = 30 + 24 * k as i32;
+        legend_area
+            .draw(&PathElement::new(
+                vec![(10, y), (40, y)],
+                color.stroke_width(3),
+            ))
+            .map_err(e)?;
+        let style = color.filled();
+        match marker {
+            0 => legend_area.draw(&Circle::new((25, y), 4, style)),
+            1 => legend_area.draw(&TriangleMarker::new((25, y), 5, style)),
+            _ => legend_area.draw(&Cross::new((25, y), 5, color.stroke_width(2))),
         }
-    })
+        .map_err(e)?;
+        legend_area
+            .draw(&Text::new(
+                name.to_string(),
+                (48, y - 8),
+                ("sans-serif", 16),
+            ))
+            .map_err(e)?;
+    }
+    root.present().map_err(e)?;
+    Ok(())
 }
 
 /// Directory of a case's fields: `fields/<material>/<surface>/<angle>`
 /// (`fields/Cu/flat/015.0`), each component made file-name safe.
 pub fn fields_dir(out_dir: &Path, key: &CaseKey) -> PathBuf {
     let mut p = out_dir.join("fields");
-    for part in [
+    let level = format!("L{}", key.level);
+    let parts = [
         key.material.as_str(),
         key.surface.as_str(),
         &key.angle_text(),
-    ] {
+        &level,
+    ];
+    // Level 0 keeps the directory it had before ladders existed.
+    let parts = if key.level == 0 {
+        &parts[..3]
+    } else {
+        &parts[..]
+    };
+    for part in parts {
         let safe: String = part
             .chars()
             .map(|c| {

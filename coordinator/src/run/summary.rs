@@ -80,8 +80,18 @@ pub struct RunSummary {
     pub rejected_messages: usize,
     /// Output files that could not be written (plots need fonts).
     pub output_warnings: Vec<String>,
-    /// Definition of the apparent radii a, c used in μa.
+    /// Definition of the apparent radii a, c used in μa (`mu_a`, `k_e`).
     pub apparent_radius_definition: &'static str,
+    /// Definition of the paper's radii (`mu_a_cells`, `k_e_cells`).
+    pub apparent_radius_definition_cells: &'static str,
+    /// Grids per case (1: no convergence ladder).
+    pub convergence_levels: usize,
+    /// How the error bars in curves.csv are formed.
+    pub error_estimate: &'static str,
+    /// Curve points left out because a level of their ladder did not solve.
+    pub incomplete_points: usize,
+    /// Per "material / surface": μa range over angle, error, resolved.
+    pub curves: BTreeMap<String, super::output::CurveSummary>,
     /// How K_E is obtained.
     pub k_e_definition: &'static str,
 }
