@@ -165,8 +165,12 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
 
     This process acts as the coordinator; each worker is this Python
     interpreter running the Rust worker (see ``mpcontact._worker``).
-    Ctrl-C stops the sweep with ``KeyboardInterrupt``.
+    Ctrl-C stops the sweep with ``KeyboardInterrupt``. A case that fails
+    is a row with status ``failed``; a run that cannot go on (output
+    directory, lock, memory, workers) raises ``RuntimeError``.
     """
+    if int(workers) < 1:
+        raise ValueError(f"workers must be at least 1, got {workers}")
     if out is None:
         out = tempfile.mkdtemp(prefix="mpcontact-run-")
     out = Path(out)

@@ -15,8 +15,8 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use coordinator::config::{heightmap_surface, Config};
-use iceoryx2_bb_posix::signal::{FetchableSignal, SignalHandler};
 use coordinator::solve::{solve_in_memory, CaseChoice};
+use iceoryx2_bb_posix::signal::{FetchableSignal, SignalHandler};
 use numpy::{Complex64, PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
@@ -257,9 +257,10 @@ fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
     if let Ok(d) = v.cast::<PyDict>() {
         let mut t = toml::Table::new();
         for (k, item) in d.iter() {
-            let k: String = k
-                .extract()
-                .map_err(|_| PyTypeError::new_err(format!("{key}: table keys must be strings")))?;
+            let k: String = k.extract().map_err(|_| {
+                let at = if key.is_empty() { "config" } else { key };
+                PyTypeError::new_err(format!("{at}: table keys must be strings"))
+            })?;
             let value = to_toml(&item, &sub(&k))?;
             t.insert(k, value);
         }
@@ -495,7 +496,9 @@ fn run<'py>(
             if e.downcast_ref::<coordinator::run::Interrupted>().is_some() {
                 PyKeyboardInterrupt::new_err(format!("{e:#}"))
             } else {
-                SolveError::new_err(format!("{e:#}"))
+                // Output directory, lock, memory, workers: the run, not a
+                // case (a case that fails is a row with status `failed`).
+                PyRuntimeError::new_err(format!("{e:#}"))
             }
         })?;
     let value = serde_json::to_value(&summary)

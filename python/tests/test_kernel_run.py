@@ -98,3 +98,6 @@ def test_run_resumes_and_defaults_to_a_temporary_directory(tmp_path):
     assert again.summary["resumed"] == 1
     with pytest.raises(ValueError, match="workers"):
         mpcontact.run(cfg, workers=0, out=tmp_path / "none", progress=False)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(RuntimeError, match="not a directory"):
+        mpcontact.run(cfg, workers=1, out=tmp_path / "file", progress=False)
