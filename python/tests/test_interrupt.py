@@ -26,12 +26,14 @@ cfg = mpcontact.Config.from_toml(sys.argv[1])
 cfg.set("grid.points", 512)
 cfg.set("solver.coupling", True)   # ~10 s of iterations
 print("start", flush=True)
-t = time.time()
+# CPU time, not wall time: on a loaded machine the solve may get little CPU,
+# and what matters is how much of its ~10 s of work it did before stopping.
+t = time.process_time()
 try:
     mpcontact.solve(cfg)
-    print("finished", flush=True)
+    print("finished", time.process_time() - t, flush=True)
 except KeyboardInterrupt:
-    print("interrupted", time.time() - t, flush=True)
+    print("interrupted", time.process_time() - t, flush=True)
 # The solver's thread is usable again, and Ctrl-C is Python's again.
 small = mpcontact.Config.from_toml(sys.argv[1])
 small.set("grid.points", 64)
@@ -60,10 +62,11 @@ def test_ctrl_c_stops_a_long_solve_with_keyboard_interrupt():
     assert p.stdout.readline().strip() == "start"
     time.sleep(1.5)
     p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=60)
+    out, err = p.communicate(timeout=600)
     lines = out.splitlines()
     assert lines[0].startswith("interrupted"), (out, err)
-    # The solve (~10 s) stopped within its next iterations, not at its end.
+    # The solve (~10 s of CPU) stopped within its next iterations (at most
+    # 1.5 s of CPU had gone into it when the signal came), not at its end.
     assert float(lines[0].split()[1]) < 4.0, lines[0]
     assert lines[1:] == ["after ok", "python ctrl-c ok"], (out, err)
 
@@ -99,7 +102,7 @@ def test_ctrl_c_stops_a_sweep_its_workers_exit_and_it_resumes(tmp_path):
     out = tmp_path / "sweep"
     p = start(SWEEP, out)
     journal = out / "journal.jsonl"
-    deadline = time.time() + 60
+    deadline = time.time() + 600  # generous: a loaded machine may give it little CPU
     # Interrupt once a case is recorded and both workers are up.
     while time.time() < deadline:
         if journal.is_file() and '"kind":"case"' in journal.read_text():
@@ -111,7 +114,7 @@ def test_ctrl_c_stops_a_sweep_its_workers_exit_and_it_resumes(tmp_path):
     line = p.stdout.readline()
     assert line.startswith("interrupted:") and "--resume" in line, line + p.stderr.read()
     assert not any(os.path.exists(f"/proc/{w}") for w in workers), "workers left behind"
-    rest, err = p.communicate(timeout=120)
+    rest, err = p.communicate(timeout=600)
     assert rest.strip(), err
     summary = json.loads(rest.splitlines()[-1])
     assert summary["total"] == 12 and summary["status"] == ["ok"], (rest, err)
