@@ -14,8 +14,9 @@ root=$(pwd)
 
 cargo test --workspace --release
 # The CLI the Python tests compare against (built by the tests above already;
-# this only makes sure of it).
-cargo build --release --bin mpcontact
+# this only makes sure of it). --workspace keeps the features the tests
+# used, so nothing is compiled again.
+cargo build --release --workspace --bin mpcontact
 target=${CARGO_TARGET_DIR:-$root/target}
 export MPCONTACT_CLI="$target/release/mpcontact"
 
