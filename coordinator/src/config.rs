@@ -607,10 +607,21 @@ fn surface_key(param: &str) -> String {
 impl Config {
     /// Reads a config file and applies `--set` overrides.
     pub fn load(path: &Path, sets: &[String]) -> Result<Config> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read config {}", path.display()))?;
+        Self::parse_file(&Self::read(path)?, sets, path)
+    }
+
+    /// The text of the config file at `path`.
+    pub fn read(path: &Path) -> Result<String> {
+        std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read config {}", path.display()))
+    }
+
+    /// Parses `text`, read from `path`, and applies `--set` overrides;
+    /// relative paths start at the file's directory, errors name the file.
+    /// (Python's `Config.set` re-parses the file's text with one more `--set`.)
+    pub fn parse_file(text: &str, sets: &[String], path: &Path) -> Result<Config> {
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Self::parse_in(&text, sets, &base).with_context(|| format!("in config {}", path.display()))
+        Self::parse_in(text, sets, &base).with_context(|| format!("in config {}", path.display()))
     }
 
     /// Parses config text and applies `--set` overrides (relative paths from the current directory).
@@ -784,6 +795,12 @@ impl Config {
         Ok(self.spec_of(self.material(material)?, self.surface(surface)?, angle_deg))
     }
 
+    /// One case spec on a surface given directly (not by name), e.g. a
+    /// [`heightmap_surface`] made from an array.
+    pub fn spec_on(&self, material: &str, surface: Surface, angle_deg: f64) -> Result<CaseSpec> {
+        Ok(self.spec_of(self.material(material)?, surface, angle_deg))
+    }
+
     /// The spec of a resolved material and surface at one angle.
     fn spec_of(&self, material: Material, surface: Surface, angle_deg: f64) -> CaseSpec {
         CaseSpec {
@@ -901,6 +918,16 @@ fn build_material(
     Material::cubic(name, constants, normal, x_dir, equivalent).map_err(explain)
 }
 
+/// The height-map surface of `n x n` heights in µm, rows along y: what
+/// `shape = "heightmap"` makes of its file (and Python of an array), so
+/// both give the solver the same metres. Not validated (`Surface::validate`).
+pub fn heightmap_surface(n: usize, heights_um: &[f64]) -> Surface {
+    Surface::Heightmap {
+        n,
+        heights: std::sync::Arc::new(heights_um.iter().map(|v| v * 1e-6).collect()),
+    }
+}
+
 fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Surface> {
     let need = |v: Option<f64>, k: &str| {
         v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{}\"", s.shape))
@@ -946,10 +973,7 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
             let path = base.join(file);
             let values =
                 read_grid_npy(&path, n).with_context(|| format!("surfaces.{name}.file"))?;
-            Surface::Heightmap {
-                n,
-                heights: std::sync::Arc::new(values.iter().map(|v| v * um).collect()),
-            }
+            heightmap_surface(n, &values)
         }
         other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap)"),
     };

@@ -254,7 +254,7 @@ fn real_main() -> Result<()> {
                 resume,
                 quiet,
                 save_fields,
-                exe: worker_exe()?,
+                exe: coordinator::run::WorkerCommand::mpcontact(worker_exe()?),
                 shard,
             };
             coordinator::run::run_sweep(&args)?;

@@ -1,5 +1,7 @@
-//! `mpcontact solve`: one case in-process (no IPC), for inspection — writes
-//! `case.json`, the fields as `.npy` (via `npy`) and their PNG maps. Touches
+//! One case in-process (no IPC), for inspection. [`solve_in_memory`] is the
+//! part shared by `mpcontact solve` and the Python module (spec, memory
+//! check, solve, flat-twin K_E, the `case.json` value); [`write_solved`] is
+//! the CLI's files (`case.json`, `.npy` fields via `npy`, PNG maps). Touches
 //! no sweep state (plan, journal, workers).
 
 use crate::case::Status;
@@ -7,12 +9,13 @@ use crate::config::Config;
 use crate::npy::write_fields;
 use anyhow::{anyhow, Context, Result};
 use serde::Serialize;
-use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Surface};
+use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Fields, Surface};
 use std::path::Path;
 
-/// What `case.json` holds.
+/// What `case.json` holds (and, as the same serde value, Python's
+/// `Result.scalars`: a key added here reaches both).
 #[derive(Serialize)]
-struct CaseJson<'a> {
+pub struct CaseJson<'a> {
     material: &'a str,
     surface: &'a str,
     angle_deg: f64,
@@ -38,17 +41,109 @@ pub struct SolveArgs<'a> {
     pub out: &'a Path,
 }
 
-/// Solves one case of `config` and writes its outputs; returns its scalars.
-pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
-    let material = args.material.unwrap_or(&config.sweep.materials[0]);
-    let surface = args.surface.unwrap_or(&config.sweep.surfaces[0]);
-    let angle = match args.angle_deg {
-        Some(a) => a,
-        None => config.sweep.angles_deg.values()?[0],
-    };
-    let spec = config.spec(material, surface, angle)?;
-    spec.validate()
-        .map_err(|e| config.explain(e, material, surface))?;
+/// One case picked from a config and checked: its names and its spec.
+#[derive(Clone, Debug)]
+pub struct CaseChoice {
+    /// Material name.
+    pub material: String,
+    /// Surface name (or the label of a surface given directly).
+    pub surface: String,
+    /// Force angle, degrees.
+    pub angle_deg: f64,
+    /// The spec, validated.
+    pub spec: CaseSpec,
+}
+
+impl CaseChoice {
+    /// The case `material` × `surface` × `angle_deg` of `config`; each
+    /// defaults to the sweep's first. Errors name config keys.
+    pub fn new(
+        config: &Config,
+        material: Option<&str>,
+        surface: Option<&str>,
+        angle_deg: Option<f64>,
+    ) -> Result<Self> {
+        let material = material.unwrap_or(&config.sweep.materials[0]);
+        let surface = surface.unwrap_or(&config.sweep.surfaces[0]);
+        let angle = Self::angle(config, angle_deg)?;
+        let spec = config.spec(material, surface, angle)?;
+        Self::checked(config, material, surface, angle, spec)
+    }
+
+    /// The same on a surface given directly (Python's height arrays),
+    /// called `label` in outputs and errors.
+    pub fn on_surface(
+        config: &Config,
+        material: Option<&str>,
+        label: &str,
+        surface: Surface,
+        angle_deg: Option<f64>,
+    ) -> Result<Self> {
+        let material = material.unwrap_or(&config.sweep.materials[0]);
+        let angle = Self::angle(config, angle_deg)?;
+        let spec = config.spec_on(material, surface, angle)?;
+        Self::checked(config, material, label, angle, spec)
+    }
+
+    fn angle(config: &Config, angle_deg: Option<f64>) -> Result<f64> {
+        match angle_deg {
+            Some(a) => Ok(a),
+            None => Ok(config.sweep.angles_deg.values()?[0]),
+        }
+    }
+
+    fn checked(
+        config: &Config,
+        material: &str,
+        surface: &str,
+        angle_deg: f64,
+        spec: CaseSpec,
+    ) -> Result<Self> {
+        spec.validate()
+            .map_err(|e| config.explain(e, material, surface))?;
+        Ok(CaseChoice {
+            material: material.to_string(),
+            surface: surface.to_string(),
+            angle_deg,
+            spec,
+        })
+    }
+}
+
+/// A solved case: what it was, its scalars (K_E calibrated) and fields.
+pub struct Solved {
+    /// The case.
+    pub case: CaseChoice,
+    /// Scalars, with an anisotropic material's K_E from its flat twin.
+    pub scalars: CaseScalars,
+    /// Fields of the case itself.
+    pub fields: Fields,
+}
+
+impl Solved {
+    /// The `case.json` of this case (serialize it, or turn it into another
+    /// serde value).
+    pub fn case_json(&self) -> CaseJson<'_> {
+        let c = &self.case;
+        CaseJson {
+            material: &c.material,
+            surface: &c.surface,
+            angle_deg: c.angle_deg,
+            status: Status::of_solved(self.scalars.converged),
+            scalars: &self.scalars,
+            apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
+            apparent_radius_definition_cells: solver::APPARENT_RADIUS_DEFINITION_CELLS,
+            grid_points: c.spec.grid.n,
+            spacing_m: c.spec.grid.dx,
+            spec: &c.spec,
+        }
+    }
+}
+
+/// Solves one case in memory: memory check, the solve, and for an
+/// anisotropic material K_E from its flat twin. Writes nothing.
+pub fn solve_in_memory(case: CaseChoice) -> Result<Solved> {
+    let spec = &case.spec;
     crate::memory::check_fits(
         "this case",
         crate::memory::worker_bytes(spec.grid.n, 1),
@@ -56,8 +151,9 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         crate::memory::available_bytes(),
     )?;
     let mut cache = worker::kernel_store::FileStore::cache();
+    let (material, surface, angle) = (&case.material, &case.surface, case.angle_deg);
     let out =
-        solve_case(&spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
+        solve_case(spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
     let mut scalars = out.scalars;
     // Anisotropic material: K_E from the flat twin (docs/physics-choices.md,
     // "Reported quantities").
@@ -71,28 +167,36 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
         };
         calibrate_on_flat(&mut scalars, &flat, &spec.load);
     }
-    std::fs::create_dir_all(args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let json = CaseJson {
-        material,
-        surface,
-        angle_deg: angle,
-        status: Status::of_solved(scalars.converged),
-        scalars: &scalars,
-        apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
-        apparent_radius_definition_cells: solver::APPARENT_RADIUS_DEFINITION_CELLS,
-        grid_points: spec.grid.n,
-        spacing_m: spec.grid.dx,
-        spec: &spec,
-    };
-    let path = args.out.join("case.json");
-    crate::atomic::write(&path, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    write_fields(args.out, &out.fields)?;
+    Ok(Solved {
+        case,
+        scalars,
+        fields: out.fields,
+    })
+}
+
+/// Writes `case.json`, the fields as `.npy` and their PNG maps into `out`.
+pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let path = out.join("case.json");
+    let json = serde_json::to_string_pretty(&solved.case_json())?;
+    crate::atomic::write(&path, json.as_bytes())?;
+    write_fields(out, &solved.fields)?;
     // The numbers are written first; a picture that cannot be drawn (e.g. no
     // system font) is a warning, not a lost result.
-    let title = format!("{material}, {surface}, ψ = {angle}°");
-    if let Err(e) = crate::maps::write_maps(args.out, &title, &out.fields, &scalars, spec.grid.dx) {
+    let c = &solved.case;
+    let title = format!("{}, {}, ψ = {}°", c.material, c.surface, c.angle_deg);
+    if let Err(e) =
+        crate::maps::write_maps(out, &title, &solved.fields, &solved.scalars, c.spec.grid.dx)
+    {
         eprintln!("warning: maps not written: {e:#}");
     }
-    Ok(scalars)
+    Ok(())
+}
+
+/// Solves one case of `config` and writes its outputs; returns its scalars.
+pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
+    let case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
+    let solved = solve_in_memory(case)?;
+    write_solved(&solved, args.out)?;
+    Ok(solved.scalars)
 }

@@ -39,6 +39,9 @@ pub enum SolverError {
         /// Context.
         detail: String,
     },
+    /// The solve was stopped by [`crate::cancel`] (e.g. Ctrl-C in Python).
+    #[error("cancelled")]
+    Cancelled,
 }
 
 impl SolverError {

@@ -65,7 +65,7 @@ pub use grid::Grid;
 pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
-pub use progress::{set_tick_hook, TickHook};
+pub use progress::{cancel, set_tick_hook, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
     APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS, K_E_DEFINITION,

@@ -193,7 +193,7 @@ fn polonsky_keer(
     let mut u_valid = false;
     let mut since_refresh = 0;
     for it in 1..=max_iterations {
-        crate::progress::tick();
+        crate::progress::tick_or_cancel()?;
         report.iterations = it;
         if !u_valid || since_refresh >= REFRESH {
             op.apply_zz(p, u);

@@ -369,7 +369,7 @@ pub fn solve_tangential_on_grid(
     // The projection's multiplier λ is the rigid shift: δt = λ / step.
     let mut t_k = 1.0_f64;
     for it in 1..=fista_budget {
-        crate::progress::tick();
+        crate::progress::tick_or_cancel()?;
         report.iterations = cg.iterations + it;
         report.applications += 1;
         slip_field(op, prob.extra, (&yx, &yy), (&mut sx, &mut sy));
@@ -541,7 +541,7 @@ fn cg_disc(
     };
     let budget = prob.max_iterations;
     for it in 1..=budget {
-        crate::progress::tick();
+        crate::progress::tick_or_cancel()?;
         out.iterations = it;
         if age >= REFRESH {
             out.applications += 1;

@@ -52,6 +52,12 @@ pub fn unix_ns() -> u64 {
         .unwrap_or(0)
 }
 
+/// A run stopped by Ctrl-C or SIGTERM (typed, so that the Python module can
+/// raise `KeyboardInterrupt` for it).
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted; the journal keeps what was recorded (use --resume)")]
+pub struct Interrupted;
+
 /// The IPC endpoints of one run.
 pub struct Exchange<'a> {
     run_id: &'a str,
@@ -133,7 +139,7 @@ impl<'a> Exchange<'a> {
         loop {
             match waitset.wait_and_process_once(|_| CallbackProgression::Continue) {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    bail!("interrupted; the journal keeps what was recorded (use --resume)")
+                    return Err(Interrupted.into())
                 }
                 Ok(_) => {}
                 Err(e) => bail!("waiting failed: {e:?}"),

@@ -27,11 +27,13 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use anyhow::Context;
 use serde::Serialize;
 
+pub use exchange::Interrupted;
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
 pub use output::{fmt_f64, CURVES_HEADER, RESULTS_HEADER};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
+pub use supervise::WorkerCommand;
 
 use crate::config::Config;
 
@@ -49,9 +51,9 @@ pub struct RunArgs {
     pub quiet: bool,
     /// Write `fields/<case>/*.npy` (or'ed with the config's `save_fields`).
     pub save_fields: bool,
-    /// The `mpcontact` binary; workers are started as
-    /// `EXE worker --run RUN_ID --index K`.
-    pub exe: PathBuf,
+    /// How workers are started (`PROGRAM [ARGS…] worker --run RUN_ID
+    /// --index K`): the `mpcontact` binary, or Python hosting the same worker.
+    pub exe: WorkerCommand,
     /// Run only this shard of the cases (`--shard K/N`).
     pub shard: Option<crate::shard::Shard>,
 }

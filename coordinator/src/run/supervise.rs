@@ -7,7 +7,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::os::unix::process::CommandExt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -17,12 +17,37 @@ use iceoryx2::prelude::*;
 
 use super::exchange::Exchange;
 
+/// How a worker process is started: `PROGRAM [ARGS…] worker --run RUN --index K`.
+#[derive(Clone, Debug)]
+pub struct WorkerCommand {
+    /// The program: the `mpcontact` binary, or a Python interpreter that
+    /// hosts the same worker (`mpcontact.run`).
+    pub program: PathBuf,
+    /// Arguments before `worker` (Python's `-c CODE`).
+    pub args: Vec<String>,
+    /// `argv[0]` shown in process lists; `None` keeps the program's path
+    /// (a Python interpreter finds its environment from it).
+    pub arg0: Option<String>,
+}
+
+impl WorkerCommand {
+    /// The `mpcontact` binary at `exe` (e.g. `/proc/self/exe`), named
+    /// `mpcontact` in process lists.
+    pub fn mpcontact(exe: PathBuf) -> Self {
+        WorkerCommand {
+            program: exe,
+            args: Vec::new(),
+            arg0: Some("mpcontact".into()),
+        }
+    }
+}
+
 /// What the supervisor starts workers with.
 pub struct SuperviseArgs<'a> {
     /// Run id (`worker --run`).
     pub run_id: &'a str,
-    /// The `mpcontact` binary.
-    pub exe: &'a Path,
+    /// How a worker is started.
+    pub exe: &'a WorkerCommand,
     /// Output directory (`worker-logs/` goes there).
     pub out_dir: &'a Path,
     /// Workers of the run; replacements are limited to `2 × workers + 2`
@@ -93,10 +118,15 @@ impl<'a> Supervisor<'a> {
         let log_path = log_dir.join(format!("worker-{k}.log"));
         let log = std::fs::File::create(&log_path)
             .with_context(|| format!("cannot create {}", log_path.display()))?;
-        // Named `mpcontact` in process lists even when started through
-        // /proc/self/exe.
-        let child = Command::new(self.args.exe)
-            .arg0("mpcontact")
+        let exe = self.args.exe;
+        let mut command = Command::new(&exe.program);
+        // The CLI's workers are named `mpcontact` in process lists even
+        // when started through /proc/self/exe.
+        if let Some(name) = &exe.arg0 {
+            command.arg0(name);
+        }
+        let child = command
+            .args(&exe.args)
             .args([
                 "worker",
                 "--run",
@@ -108,7 +138,7 @@ impl<'a> Supervisor<'a> {
             .stdout(log.try_clone()?)
             .stderr(log)
             .spawn()
-            .with_context(|| format!("while starting worker {k} ({})", self.args.exe.display()))?;
+            .with_context(|| format!("while starting worker {k} ({})", exe.program.display()))?;
         self.children.insert(k, child);
         Ok(k)
     }

@@ -1,0 +1,227 @@
+"""mpcontact: frictional contact of a rigid sphere on an elastic half-space.
+
+The Rust solver and sweep runner of the ``mpcontact`` command line, called
+from Python — the same config loader, solve, kernels and worker processes,
+not a second implementation::
+
+    import mpcontact
+    cfg = mpcontact.Config.from_toml("configs/mindlin-uncoupled.toml")
+    cfg.set("grid.points", 128)
+    res = mpcontact.solve(cfg)
+    res.scalars["contact_radius_m"], res.fields["p"].shape
+
+See ``python/README.md`` for the whole API with examples.
+"""
+
+import csv
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from mpcontact import _native
+from mpcontact._native import Config, SolveError
+
+__all__ = [
+    "Config",
+    "Result",
+    "RunResult",
+    "SolveError",
+    "FIELD_NAMES",
+    "kernel",
+    "materials",
+    "run",
+    "solve",
+]
+
+#: The fields of a solved case, as the CLI's ``.npy`` files are named.
+FIELD_NAMES = ("p", "qx", "qy", "sx", "sy", "stick", "ux", "uy", "uz")
+
+
+class Result:
+    """One solved case.
+
+    ``scalars``: dict with exactly the keys and values of the CLI's
+    ``case.json`` (same serde value). ``fields``: dict of float64 ``(n, n)``
+    arrays, rows along y, SI units (Pa, m; ``stick`` is 0/1) — the CLI's
+    ``.npy`` files.
+    """
+
+    __slots__ = ("scalars", "fields")
+
+    def __init__(self, scalars, fields):
+        self.scalars = scalars
+        self.fields = fields
+
+    @property
+    def spacing_m(self):
+        """Cell size, m."""
+        return self.scalars["spacing_m"]
+
+    def coordinates_m(self):
+        """``(x, y)`` cell-centre coordinates, m, as 1-D arrays (the grid is
+        centred on the sphere's apex)."""
+        import numpy as np
+
+        n = self.scalars["grid_points"]
+        c = (np.arange(n) - (n - 1) / 2.0) * self.spacing_m
+        return c, c.copy()
+
+    def __repr__(self):
+        s = self.scalars
+        return (
+            f"Result({s['material']}/{s['surface']}/{s['angle_deg']}°: "
+            f"a = {s['contact_radius_m']:.4e} m, c = {s['stick_radius_m']:.4e} m, "
+            f"mu_a = {s['mu_a']}, status = {s['status']})"
+        )
+
+
+def solve(cfg, material=None, surface=None, angle_deg=None):
+    """Solve one case of ``cfg`` in this process (what ``mpcontact solve`` does,
+    without writing files) and return a :class:`Result`.
+
+    ``material``, ``surface`` and ``angle_deg`` default to the sweep's first.
+    ``surface`` is a name (preset or ``[surfaces.*]``) or an ``(n, n)`` array
+    of heights in µm, rows along y — the same as a ``shape = "heightmap"``
+    surface reading that array from a ``.npy`` file.
+
+    The GIL is released while solving; Ctrl-C stops the solve with
+    ``KeyboardInterrupt``. Raises ``ValueError`` for a bad argument or
+    config (naming the key) and :class:`SolveError` for a case the solver
+    could not solve.
+    """
+    heights = None
+    name = surface
+    if surface is not None and not isinstance(surface, str):
+        import numpy as np
+
+        heights = np.ascontiguousarray(surface, dtype=np.float64)
+        if heights.ndim != 2:
+            raise ValueError(
+                f"surface: a height array must be 2-D (n, n), got shape {heights.shape}"
+            )
+        name = None
+    if angle_deg is not None:
+        angle_deg = float(angle_deg)
+    scalars, fields = _native.solve(
+        cfg, material=material, surface=name, heights=heights, angle_deg=angle_deg
+    )
+    return Result(scalars, fields)
+
+
+def kernel(material, angles_deg, cfg=None):
+    """The Fourier-domain surface compliance H(θ) of ``material`` at each
+    angle (degrees), 1/Pa: complex128 array ``(m, 3, 3)``, the matrices
+    ``mpcontact kernel`` prints. ``material`` is a preset name, or a
+    ``[materials.*]`` name of ``cfg``."""
+    import numpy as np
+
+    angles = np.atleast_1d(np.asarray(angles_deg, dtype=np.float64))
+    if angles.ndim != 1:
+        raise ValueError(f"angles_deg: expected a 1-D list of angles, got shape {angles.shape}")
+    return _native.kernel(material, angles.tolist(), cfg)
+
+
+def materials():
+    """The preset material names (``mpcontact materials``)."""
+    return _native.materials()
+
+
+class RunResult:
+    """The outputs of a sweep.
+
+    ``results``: ``results.csv`` as a dict of numpy columns (one entry per
+    case; numbers as float64, empty cells NaN, text as str arrays).
+    ``curves``: ``curves.csv`` the same way. ``summary``: the run's tallies
+    and timings (summary.json without the config echo). ``out``: the output
+    directory with every file ``mpcontact run`` writes.
+    """
+
+    __slots__ = ("results", "curves", "summary", "out")
+
+    def __init__(self, results, curves, summary, out):
+        self.results = results
+        self.curves = curves
+        self.summary = summary
+        self.out = out
+
+    def __repr__(self):
+        s = self.summary
+        return (
+            f"RunResult({s.get('total')} cases: {s.get('ok')} ok, "
+            f"{s.get('not_converged')} not converged, {s.get('failed')} failed → {self.out})"
+        )
+
+
+def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False):
+    """Run the sweep of ``cfg`` on ``workers`` worker processes — the
+    coordinator and workers of ``mpcontact run`` — and return a
+    :class:`RunResult`.
+
+    ``out``: output directory (a new temporary directory when ``None``);
+    it gets the same files as ``mpcontact run --out``. ``resume`` continues
+    an interrupted sweep in ``out``. ``progress`` shows the progress bar on
+    stderr. ``save_fields`` also writes ``fields/<case>/*.npy``.
+
+    This process acts as the coordinator; each worker is this Python
+    interpreter running the Rust worker (see ``mpcontact._worker``).
+    Ctrl-C stops the sweep with ``KeyboardInterrupt``. A case that fails
+    is a row with status ``failed``; a run that cannot go on (output
+    directory, lock, memory, workers) raises ``RuntimeError``.
+    """
+    if int(workers) < 1:
+        raise ValueError(f"workers must be at least 1, got {workers}")
+    if out is None:
+        out = tempfile.mkdtemp(prefix="mpcontact-run-")
+    out = Path(out)
+    program, args = _worker_command()
+    summary = _native.run(
+        cfg, int(workers), str(out), bool(resume), not progress, bool(save_fields), program, args
+    )
+    return RunResult(
+        results=_read_csv(out / "results.csv"),
+        curves=_read_csv(out / "curves.csv"),
+        summary=summary,
+        out=out,
+    )
+
+
+def _worker_command():
+    """How a worker is started: this interpreter, importing this very
+    installation (its parent directory goes first on ``sys.path``, so the
+    current directory or a source tree cannot shadow it)."""
+    if not sys.executable or not os.access(sys.executable, os.X_OK):
+        raise RuntimeError(
+            "mpcontact.run needs sys.executable (the Python interpreter) to start its workers"
+        )
+    parent = str(Path(__file__).resolve().parent.parent)
+    code = (
+        "import sys; sys.path.insert(0, {!r}); "
+        "from mpcontact._worker import main; main()".format(parent)
+    )
+    return sys.executable, ["-c", code]
+
+
+def _read_csv(path):
+    """A CSV written by the runner as a dict of numpy columns."""
+    import numpy as np
+
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return {}
+    header, body = rows[0], rows[1:]
+    columns = {}
+    for j, name in enumerate(header):
+        cells = [r[j] if j < len(r) else "" for r in body]
+        columns[name] = _column(cells, np)
+    return columns
+
+
+def _column(cells, np):
+    """float64 when every cell is a number (empty → NaN; the angle "30" is a
+    number like any other), else str."""
+    try:
+        return np.array([float(c) if c != "" else np.nan for c in cells], dtype=np.float64)
+    except ValueError:
+        return np.array(cells, dtype=str)

@@ -1,0 +1,103 @@
+"""kernel() and materials() against the CLI; run() with two workers."""
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import mpcontact
+
+
+def test_materials_are_the_cli_presets(cli):
+    table = subprocess.run([str(cli), "materials"], capture_output=True, text=True, check=True)
+    lines = table.stdout.splitlines()[1:]
+    names = [l.split()[0] for l in lines[: lines.index("")]]
+    assert mpcontact.materials() == names
+    assert {"Fe", "Cu", "Cu(111)"} <= set(names)
+
+
+@pytest.mark.parametrize("material", ["Fe", "Cu(111)"])
+def test_kernel_equals_the_cli_kernel_bit_for_bit(cli, material):
+    out = subprocess.run(
+        [str(cli), "kernel", "--material", material, "--angles-deg", "0:180:45"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    rows = json.loads(out.stdout)
+    h = mpcontact.kernel(material, [0, 45, 90, 135, 180])
+    assert h.shape == (5, 3, 3) and h.dtype == np.complex128
+    # Parts set one by one: re + 1j*im would turn −0.0 parts into +0.0.
+    theirs = np.empty((len(rows), 3, 3), dtype=np.complex128)
+    theirs.real = [r["H_re"] for r in rows]
+    theirs.imag = [r["H_im"] for r in rows]
+    assert h.tobytes() == theirs.tobytes()
+
+
+def test_isotropic_kernel_is_the_closed_form():
+    """Isotropic half-space: H_zz = 2(1 − ν²)/E at every angle (1/Pa, per |k|)."""
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 64, "spacing_um": 6.0},
+            "indenter": {"radius_mm": 18.0},
+            "load": {"normal_n": 20.0, "friction": 0.3},
+            "sweep": {"materials": ["soft"]},
+            "materials": {"soft": {"isotropic": {"youngs_gpa": 100.0, "poisson": 0.25}}},
+        }
+    )
+    h = mpcontact.kernel("soft", np.linspace(0, 180, 7), cfg=cfg)
+    assert np.allclose(h[:, 2, 2].real, 2 * (1 - 0.25**2) / 100e9, rtol=1e-9)
+    with pytest.raises(ValueError, match="unknown preset"):
+        mpcontact.kernel("soft", [0.0])
+    with pytest.raises(ValueError, match="finite"):
+        mpcontact.kernel("Fe", [np.nan])
+
+
+def test_a_sweep_on_two_workers_returns_every_case_equal_to_solve(tmp_path):
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 64, "spacing_um": 6.0},
+            "indenter": {"radius_mm": 18.0},
+            "load": {"normal_n": 20.0, "friction": 0.28571, "tangential_ratio": 0.6},
+            "sweep": {"materials": ["Fe", "Cu"], "surfaces": ["flat"], "angles_deg": [0, 45, 90]},
+            "solver": {"coupling": False, "tolerance": 1e-10, "tangential_tolerance": 1e-6},
+        }
+    )
+    out = tmp_path / "sweep"
+    res = mpcontact.run(cfg, workers=2, out=out, progress=False)
+    r = res.results
+    assert len(r["material"]) == 6
+    assert sorted(zip(r["material"], r["angle_deg"])) == sorted(
+        (m, a) for m in ("Fe", "Cu") for a in (0.0, 45.0, 90.0)
+    )
+    assert list(r["status"]) == ["ok"] * 6
+    assert set(r["worker"]) <= {0.0, 1.0, 2.0, 3.0}
+    assert res.summary["total"] == 6 and res.summary["ok"] == 6
+    assert len(res.curves["mu_a"]) == 6
+    for name in ("results.csv", "curves.csv", "summary.json", "journal.jsonl"):
+        assert (out / name).is_file(), name
+    # Each row is the in-process solve of the same case, to the bit.
+    for m, a, mu, c in zip(r["material"], r["angle_deg"], r["mu_a"], r["stick_radius_m"]):
+        s = mpcontact.solve(cfg, material=str(m), angle_deg=a).scalars
+        assert (mu, c) == (s["mu_a"], s["stick_radius_m"])
+
+
+def test_run_resumes_and_defaults_to_a_temporary_directory(tmp_path):
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 64, "spacing_um": 6.0},
+            "indenter": {"radius_mm": 18.0},
+            "load": {"normal_n": 20.0, "friction": 0.3},
+            "sweep": {"materials": ["Fe"], "angles_deg": [0]},
+        }
+    )
+    first = mpcontact.run(cfg, workers=1, progress=False)
+    assert first.out.is_dir() and list(first.results["status"]) == ["ok"]
+    again = mpcontact.run(cfg, workers=1, out=first.out, resume=True, progress=False)
+    assert again.summary["resumed"] == 1
+    with pytest.raises(ValueError, match="workers"):
+        mpcontact.run(cfg, workers=0, out=tmp_path / "none", progress=False)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(RuntimeError, match="not a directory"):
+        mpcontact.run(cfg, workers=1, out=tmp_path / "file", progress=False)

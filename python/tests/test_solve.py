@@ -1,0 +1,202 @@
+"""Single solves through Python against the CLI (bit for bit), the closed
+forms, and the equilibrium of the returned fields."""
+
+import math
+
+import numpy as np
+import pytest
+
+import mpcontact
+from conftest import mindlin_text
+
+# Wall-clock times: the only keys of case.json that differ between two
+# identical solves.
+TIMES = ("seconds", "kernel_seconds")
+
+
+def without_times(d):
+    return {k: v for k, v in d.items() if k not in TIMES}
+
+
+def assert_same_as_cli(res, case_json, cli_dir):
+    """Every key and value of case.json, and every .npy field, bit for bit."""
+    assert set(res.scalars) == set(case_json)
+    assert without_times(res.scalars) == without_times(case_json)
+    for k, v in without_times(res.scalars).items():
+        if isinstance(v, float):
+            # == would let -0.0 and 0.0 pass; the bits must be the same.
+            assert np.float64(v).tobytes() == np.float64(case_json[k]).tobytes(), k
+    for name in mpcontact.FIELD_NAMES:
+        ours = res.fields[name]
+        theirs = np.load(cli_dir / f"{name}.npy")
+        assert ours.tobytes() == theirs.tobytes(), name
+
+
+def test_hertz_scalars_and_fields_equal_the_cli_bit_for_bit(tmp_path, cli_solve):
+    path = tmp_path / "hertz.toml"
+    path.write_text(mindlin_text(ratio=0.0))
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert_same_as_cli(res, case_json, cli_dir)
+    # And it is Hertz: a within 2 cells, p_max within 2 % of p0.
+    s = res.scalars
+    assert abs(s["contact_radius_m"] - s["hertz_radius_m"]) < 2 * s["spacing_m"]
+    assert s["p_max_pa"] == pytest.approx(s["hertz_pressure_pa"], rel=0.02)
+    assert s["mu_a"] is None, "no tangential load, no μa"
+
+
+def test_mindlin_scalars_and_fields_equal_the_cli_bit_for_bit(tmp_path, cli_solve):
+    path = tmp_path / "mindlin.toml"
+    path.write_text(mindlin_text(ratio=0.6, angle=30.0))
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert_same_as_cli(res, case_json, cli_dir)
+    # Cattaneo–Mindlin: c = a (1 − Q/μP)^(1/3), within 3 cells.
+    s = res.scalars
+    c = s["contact_radius_m"] * (1 - 0.6) ** (1 / 3)
+    assert abs(s["stick_radius_m"] - c) < 3 * s["spacing_m"]
+    assert s["status"] == "ok"
+
+
+def test_set_gives_the_cli_set_result_bit_for_bit(tmp_path, cli_solve):
+    path = tmp_path / "mindlin.toml"
+    path.write_text(mindlin_text())
+    case_json, cli_dir = cli_solve(path, "--set", "grid.points=80", "--angle-deg", "90")
+    cfg = mpcontact.Config.from_toml(path)
+    cfg.set("grid.points", 80)
+    res = mpcontact.solve(cfg, angle_deg=90)
+    assert res.fields["p"].shape == (80, 80)
+    assert_same_as_cli(res, case_json, cli_dir)
+
+
+def test_anisotropic_flat_twin_k_e_equals_the_cli(tmp_path, cli_solve):
+    """Cu(111) on a pattern: K_E comes from the flat twin in both."""
+    path = tmp_path / "cu111.toml"
+    path.write_text(
+        """
+[grid]
+points = 64
+spacing_um = 120.0
+[indenter]
+radius_mm = 200.0
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+[sweep]
+materials = ["Cu(111)"]
+surfaces = ["circle-A"]
+angles_deg = [30.0]
+"""
+    )
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert res.scalars["k_e_source"] == "flat-calibrated"
+    assert_same_as_cli(res, case_json, cli_dir)
+
+
+def test_fields_are_float64_n_by_n_and_in_equilibrium():
+    cfg = mpcontact.Config.from_dict(_dict_config(points=64, ratio=0.6, angle=45.0))
+    res = mpcontact.solve(cfg)
+    assert set(res.fields) == set(mpcontact.FIELD_NAMES)
+    for name, f in res.fields.items():
+        assert f.dtype == np.float64 and f.shape == (64, 64), name
+        assert f.flags.c_contiguous
+    da = res.scalars["spacing_m"] ** 2
+    p, qx, qy = res.fields["p"], res.fields["qx"], res.fields["qy"]
+    # Σ p ΔA = P and Σ q ΔA = F (along 45°), to 1e-9 relative.
+    assert abs(p.sum() * da - 20.0) <= 1e-9 * 20.0
+    f = 0.6 * 0.28571 * 20.0
+    assert abs(qx.sum() * da - f * math.cos(math.radians(45))) <= 1e-9 * f
+    assert abs(qy.sum() * da - f * math.sin(math.radians(45))) <= 1e-9 * f
+    stick = res.fields["stick"]
+    assert set(np.unique(stick)) <= {0.0, 1.0}
+    assert stick.sum() * da == pytest.approx(res.scalars["stick_area_m2"], rel=1e-12)
+
+
+def test_rows_are_y():
+    """Under a normal load the in-plane displacement is radial: ux is odd
+    along x (columns, axis 1) and even along y (rows, axis 0); uy the
+    other way round."""
+    cfg = mpcontact.Config.from_dict(_dict_config(points=64, ratio=0.0))
+    res = mpcontact.solve(cfg)
+    ux, uy = res.fields["ux"], res.fields["uy"]
+    scale = np.abs(ux).max()
+    assert scale > 0
+    assert np.abs(ux + ux[:, ::-1]).max() < 1e-6 * scale
+    assert np.abs(ux - ux[::-1, :]).max() < 1e-6 * scale
+    assert np.abs(uy + uy[::-1, :]).max() < 1e-6 * scale
+    assert np.abs(uy - uy[:, ::-1]).max() < 1e-6 * scale
+    assert np.abs(ux - ux[:, ::-1]).max() > 0.5 * scale
+
+
+def test_a_height_array_equals_the_npy_file_route_bit_for_bit(tmp_path, cli_solve):
+    rng = np.random.default_rng(7)
+    n = 64
+    y, x = np.mgrid[0:n, 0:n]
+    h = 6.0 * np.exp(-((x - 40) ** 2 + (y - 24) ** 2) / 30.0)  # one bump, µm
+    h += rng.uniform(0.0, 0.5, size=(n, n))
+    np.save(tmp_path / "h.npy", h)
+    path = tmp_path / "map.toml"
+    path.write_text(
+        """
+[grid]
+points = 64
+spacing_um = 120.0
+[indenter]
+radius_mm = 200.0
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+[sweep]
+materials = ["Cu"]
+surfaces = ["rough"]
+angles_deg = [45.0]
+[surfaces.rough]
+shape = "heightmap"
+file = "h.npy"
+"""
+    )
+    cfg = mpcontact.Config.from_toml(path)
+    by_file = mpcontact.solve(cfg)
+    by_array = mpcontact.solve(cfg, surface=h)
+    # A Fortran-ordered copy is the same heights.
+    by_f_array = mpcontact.solve(cfg, surface=np.asfortranarray(h))
+    case_json, cli_dir = cli_solve(path)
+    assert_same_as_cli(by_file, case_json, cli_dir)
+    for res in (by_array, by_f_array):
+        assert res.scalars["surface"] == "array"
+        assert without_times({**res.scalars, "surface": "rough"}) == without_times(by_file.scalars)
+        for name in mpcontact.FIELD_NAMES:
+            assert res.fields[name].tobytes() == by_file.fields[name].tobytes(), name
+    assert by_file.scalars["base_contact"] or by_file.scalars["contact_area_m2"] > 0
+
+
+def test_bad_height_arrays_raise_value_error():
+    cfg = mpcontact.Config.from_dict(_dict_config(points=64))
+    with pytest.raises(ValueError, match="grid is 64 x 64"):
+        mpcontact.solve(cfg, surface=np.zeros((32, 32)))
+    with pytest.raises(ValueError, match="2-D"):
+        mpcontact.solve(cfg, surface=np.zeros(64))
+    bad = np.zeros((64, 64))
+    bad[3, 5] = np.nan
+    with pytest.raises(ValueError, match="height"):
+        mpcontact.solve(cfg, surface=bad)
+
+
+def test_solver_failures_raise_solve_error():
+    # A 64² grid of 0.5 µm cells is far smaller than the ~105 µm contact.
+    cfg = mpcontact.Config.from_dict(_dict_config(points=64, spacing_um=0.5))
+    with pytest.raises(mpcontact.SolveError, match="edge of the domain"):
+        mpcontact.solve(cfg)
+
+
+def _dict_config(points=64, ratio=0.6, angle=0.0, spacing_um=None):
+    return {
+        "grid": {"points": points, "spacing_um": spacing_um or 384.0 / points},
+        "indenter": {"radius_mm": 18.0},
+        "load": {"normal_n": 20.0, "friction": 0.28571, "tangential_ratio": ratio},
+        "sweep": {"materials": ["Fe"], "surfaces": ["flat"], "angles_deg": [angle]},
+        "solver": {"coupling": False, "tolerance": 1e-10, "tangential_tolerance": 1e-6},
+    }
