@@ -100,8 +100,16 @@ struct Attached {
 /// How a wait for the coordinator's answer ended.
 enum Answer<K> {
     Message(Box<CoordMessage<K>>),
-    CoordinatorGone,
+    /// The coordinator is gone; why the worker concluded so.
+    CoordinatorGone(&'static str),
 }
+
+/// Consecutive checks in which the coordinator's node must be missing from
+/// the node list before a worker concludes it is gone (one check per
+/// `WAIT_PERIOD` without an answer). Workers have twice left a live run
+/// saying it was gone (paper sweeps during #15; which check fired was not
+/// logged then), so the one check that can be transient is repeated.
+const UNLISTED_CHECKS: u32 = 3;
 
 /// Attach to run `run_id` as worker `worker_index`, solve cases until the
 /// coordinator says `Done` (or disappears), then detach. Returns an error
@@ -126,19 +134,21 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
     loop {
         let pending = w.send(&next, fields_buf.as_ref())?;
         let answer = match w.wait_answer::<K>(&pending)? {
-            Answer::Message(m) => Some(*m),
-            Answer::CoordinatorGone => None,
+            Answer::Message(m) => Ok(*m),
+            Answer::CoordinatorGone(why) => Err(why),
         };
         match answer {
-            None => {
-                eprintln!("worker {worker_index}: coordinator of run {run_id} is gone; exiting");
+            Err(why) => {
+                eprintln!(
+                    "worker {worker_index}: coordinator of run {run_id} is gone ({why}); exiting"
+                );
                 return Ok(());
             }
-            Some(ToWorker::Done) => return Ok(()),
-            Some(ToWorker::Rejected { reason }) => {
+            Ok(ToWorker::Done) => return Ok(()),
+            Ok(ToWorker::Rejected { reason }) => {
                 bail!("worker {worker_index}: rejected by the coordinator: {reason}")
             }
-            Some(ToWorker::Case(case)) => {
+            Ok(ToWorker::Case(case)) => {
                 drop(pending);
                 heartbeat.borrow_mut().beat();
                 #[cfg(feature = "fault-injection")]
@@ -302,6 +312,7 @@ impl Attached {
     /// Wait for the coordinator's answer to `pending`, checking on every
     /// timeout that the coordinator is still there.
     fn wait_answer<K: WireKey>(&self, pending: &Pending) -> anyhow::Result<Answer<K>> {
+        let mut unlisted = 0;
         loop {
             if let Some(response) = pending
                 .receive()
@@ -316,22 +327,37 @@ impl Attached {
                 .listener
                 .timed_wait(|_| {}, WAIT_PERIOD)
                 .map_err(|e| anyhow!("waiting for the coordinator failed: {e:?}"))?;
-            if woke == 0 && !self.coordinator_alive(pending) {
-                return Ok(Answer::CoordinatorGone);
+            if woke == 0 {
+                if let Some(why) = self.coordinator_gone(pending, &mut unlisted) {
+                    return Ok(Answer::CoordinatorGone(why));
+                }
             }
         }
     }
 
-    fn coordinator_alive(&self, pending: &Pending) -> bool {
+    /// Why the coordinator is gone, or None while it may still answer. A
+    /// dropped request or a node listed dead are final; a node missing from
+    /// the list only after `UNLISTED_CHECKS` checks in a row (`unlisted`
+    /// counts them): one missing listing is not taken as proof. The reason
+    /// goes into the worker's log, so that a false "gone" can be traced.
+    fn coordinator_gone(&self, pending: &Pending, unlisted: &mut u32) -> Option<&'static str> {
         self.node.try_cleanup_dead_nodes();
         if !pending.is_connected() {
-            return false;
+            return Some("it dropped this worker's request");
         }
         let name = protocol::coord_node_name(&self.run_id);
-        !matches!(
-            protocol::node_alive(&self.cfg, &name),
-            Ok(None | Some(false))
-        )
+        match protocol::node_alive(&self.cfg, &name) {
+            Ok(Some(false)) => Some("its node is listed dead"),
+            Ok(None) => {
+                *unlisted += 1;
+                (*unlisted >= UNLISTED_CHECKS).then_some("its node is no longer listed")
+            }
+            // Listed alive, or the list cannot be read: keep waiting.
+            Ok(Some(true)) | Err(_) => {
+                *unlisted = 0;
+                None
+            }
+        }
     }
 }
 
