@@ -728,21 +728,12 @@ impl Config {
         Ok(())
     }
 
-    /// A ladder needs surfaces that can be sampled on any grid.
+    /// The ladder's length (its surfaces are checked where they are
+    /// resolved, in [`Config::cases`]).
     fn check_ladder(&self) -> Result<()> {
         let levels = self.convergence.levels;
         if !(1..=MAX_LEVELS).contains(&levels) {
             bail!("convergence.levels = {levels}: must be 1 (no ladder) to {MAX_LEVELS}");
-        }
-        if levels > 1 {
-            if let Some(name) = self
-                .sweep
-                .surfaces
-                .iter()
-                .find(|s| self.surfaces.get(*s).is_some_and(|c| c.file.is_some()))
-            {
-                bail!("convergence.levels = {levels}: surface `{name}` is a height map, sampled on one grid only; ladders need surfaces defined by shape (or levels = 1)");
-            }
         }
         Ok(())
     }
@@ -750,6 +741,8 @@ impl Config {
     /// The grid of ladder level `level` (level 0: `[grid]` itself).
     pub fn level_grid(&self, level: usize) -> Grid {
         let spacing = self.grid.spacing_um * 1e-6;
+        // Level 0 is the spacing as given, not spacing · n / n, which can
+        // differ in the last bit and would change every result without a ladder.
         if level == 0 {
             return Grid::square(self.grid.points, spacing);
         }
@@ -833,7 +826,15 @@ impl Config {
             .sweep
             .surfaces
             .iter()
-            .map(|s| Ok((s, self.surface(s)?)))
+            .map(|s| {
+                let surface = self.surface(s)?;
+                // A height map is sampled on its own grid only.
+                let levels = self.convergence.levels;
+                if levels > 1 && matches!(surface, Surface::Heightmap { .. }) {
+                    bail!("convergence.levels = {levels}: surface `{s}` is a height map, sampled on one grid only; ladders need surfaces defined by shape (or levels = 1)");
+                }
+                Ok((s, surface))
+            })
             .collect::<Result<Vec<_>>>()?;
         let mut out = Vec::new();
         for m in &self.sweep.materials {
@@ -841,15 +842,21 @@ impl Config {
             for (s, surface) in &surfaces {
                 for &a in &angles {
                     let spec = self.spec_of(material.clone(), surface.clone(), a);
-                    for level in 1..self.convergence.levels {
-                        let finer = CaseSpec {
-                            grid: self.level_grid(level),
-                            ..spec.clone()
-                        };
-                        out.push((CaseKey::new(m, s, a).at_level(level), finer));
-                    }
-                    let at = out.len() + 1 - self.convergence.levels;
-                    out.insert(at, (CaseKey::new(m, s, a), spec));
+                    let finer: Vec<_> = (1..self.convergence.levels)
+                        .map(|level| {
+                            let grid = self.level_grid(level);
+                            let key = CaseKey::new(m, s, a).at_level(level);
+                            (
+                                key,
+                                CaseSpec {
+                                    grid,
+                                    ..spec.clone()
+                                },
+                            )
+                        })
+                        .collect();
+                    out.push((CaseKey::new(m, s, a), spec));
+                    out.extend(finer);
                 }
             }
         }
@@ -1299,6 +1306,42 @@ angles_deg = { start = 0, stop = 90, step = 45 }
         let missing = text.replace("h.npy", "nope.npy");
         let e = format!("{:#}", Config::parse_in(&missing, &[], &dir).unwrap_err());
         assert!(e.contains("surfaces.rough.file"), "{e}");
+        // A height map has no finer grids: a ladder on it is refused, by name.
+        let sets = ["convergence.levels=2".to_string()];
+        let e = format!("{:#}", Config::parse_in(&text, &sets, &dir).unwrap_err());
+        assert!(
+            e.contains("convergence.levels = 2: surface `rough` is a height map"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn ladder_levels_and_grids() {
+        for bad in ["0", "5"] {
+            let e = err(BASE, &[&format!("convergence.levels={bad}")]);
+            assert!(
+                e.contains(&format!("convergence.levels = {bad}: must be 1")),
+                "{e}"
+            );
+        }
+        // h, h/√2 (5-smooth), h/2, h/(2√2) on one domain; level 0 as given.
+        assert_eq!(
+            (0..4).map(|k| ladder_points(384, k)).collect::<Vec<_>>(),
+            vec![384, 540, 768, 1080]
+        );
+        let c = Config::parse(BASE, &["convergence.levels=3".into()]).unwrap();
+        assert_eq!(c.level_grid(0).dx, c.grid.spacing_um * 1e-6);
+        assert_eq!(c.finest_points(), 2 * c.grid.points);
+        let cases = c.cases().unwrap();
+        assert_eq!(
+            cases.len(),
+            3 * Config::parse(BASE, &[]).unwrap().cases().unwrap().len()
+        );
+        let (k0, s0) = &cases[0];
+        let (k1, s1) = &cases[1];
+        assert_eq!((k0.level, k1.level), (0, 1));
+        let domain = |g: &Grid| g.n as f64 * g.dx;
+        assert!((domain(&s1.grid) / domain(&s0.grid) - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -43,6 +43,29 @@ def mindlin_text(ratio=0.6, angle=0.0, coupling="false"):
     return MINDLIN.format(ratio=ratio, angle=angle, coupling=coupling)
 
 
+# Paper Table 1(c) loading (R = 200 mm, P = 6 kN, μ = 0.3, F = 0.6 μP) on a
+# coarse 64² grid of 120 µm cells: the patterned and height-map cases.
+PATTERN = """
+[grid]
+points = 64
+spacing_um = 120.0
+[indenter]
+radius_mm = 200.0
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+[sweep]
+materials = ["{material}"]
+surfaces = ["{surface}"]
+angles_deg = [{angle}]
+"""
+
+
+def pattern_text(material, surface, angle, extra=""):
+    return PATTERN.format(material=material, surface=surface, angle=angle) + extra
+
+
 @pytest.fixture(scope="session", autouse=True)
 def private_kernel_cache(tmp_path_factory):
     """Anisotropic kernels go to a directory of this session, for the

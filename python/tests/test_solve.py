@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import mpcontact
-from conftest import mindlin_text
+from conftest import mindlin_text, pattern_text
 
 # Wall-clock times: the only keys of case.json that differ between two
 # identical solves.
@@ -72,23 +72,7 @@ def test_set_gives_the_cli_set_result_bit_for_bit(tmp_path, cli_solve):
 def test_anisotropic_flat_twin_k_e_equals_the_cli(tmp_path, cli_solve):
     """Cu(111) on a pattern: K_E comes from the flat twin in both."""
     path = tmp_path / "cu111.toml"
-    path.write_text(
-        """
-[grid]
-points = 64
-spacing_um = 120.0
-[indenter]
-radius_mm = 200.0
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.6
-[sweep]
-materials = ["Cu(111)"]
-surfaces = ["circle-A"]
-angles_deg = [30.0]
-"""
-    )
+    path.write_text(pattern_text("Cu(111)", "circle-A", 30.0))
     case_json, cli_dir = cli_solve(path)
     res = mpcontact.solve(mpcontact.Config.from_toml(path))
     assert res.scalars["k_e_source"] == "flat-calibrated"
@@ -139,24 +123,7 @@ def test_a_height_array_equals_the_npy_file_route_bit_for_bit(tmp_path, cli_solv
     np.save(tmp_path / "h.npy", h)
     path = tmp_path / "map.toml"
     path.write_text(
-        """
-[grid]
-points = 64
-spacing_um = 120.0
-[indenter]
-radius_mm = 200.0
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.6
-[sweep]
-materials = ["Cu"]
-surfaces = ["rough"]
-angles_deg = [45.0]
-[surfaces.rough]
-shape = "heightmap"
-file = "h.npy"
-"""
+        pattern_text("Cu", "rough", 45.0, '[surfaces.rough]\nshape = "heightmap"\nfile = "h.npy"\n')
     )
     cfg = mpcontact.Config.from_toml(path)
     by_file = mpcontact.solve(cfg)

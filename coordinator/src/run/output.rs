@@ -171,35 +171,47 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
     let (mut points, mut incomplete) = (Vec::new(), 0);
     for (_, (key, mut rs)) in by_point {
         rs.sort_by_key(|r| r.case.key.level);
-        let solved: Vec<(f64, &CaseScalars, f64)> = rs
+        // (cell size, scalars) of every level that solved and converged.
+        let solved: Vec<(f64, &CaseScalars)> = rs
             .iter()
             .filter(|r| r.record.status == Status::Ok)
-            .filter_map(|r| {
-                let s = r.scalars.as_ref()?;
-                Some((r.case.spec.grid.dx, s, s.mu_a?))
-            })
+            .filter_map(|r| Some((r.case.spec.grid.dx, r.scalars.as_ref()?)))
             .collect();
         if solved.len() != levels {
             incomplete += 1;
             continue;
         }
-        let series = |g: &dyn Fn(&CaseScalars) -> f64| -> Vec<(f64, f64)> {
-            solved.iter().map(|&(h, s, _)| (h, g(s))).collect()
+        // No tangential load, no μa: not a curve point, and nothing missing.
+        let Some(mu_a_by_level) = solved
+            .iter()
+            .map(|(_, s)| s.mu_a)
+            .collect::<Option<Vec<f64>>>()
+        else {
+            continue;
         };
+        let hs = solved.iter().map(|&(h, _)| h);
         let (Some(mu_a), Some(k_e)) = (
-            estimate(&series(&|s| s.mu_a.unwrap_or(f64::NAN))),
-            estimate(&series(&|s| s.k_e)),
+            estimate(
+                &hs.clone()
+                    .zip(mu_a_by_level.iter().copied())
+                    .collect::<Vec<_>>(),
+            ),
+            estimate(
+                &hs.zip(solved.iter().map(|(_, s)| s.k_e))
+                    .collect::<Vec<_>>(),
+            ),
         ) else {
             continue;
         };
+        let (_, finest) = solved[solved.len() - 1];
         points.push(CurvePoint {
             key,
             mu_a,
             k_e,
-            mu_a_by_level: solved.iter().map(|p| p.2).collect(),
-            mu_a_cells: solved.last().and_then(|p| p.1.mu_a_cells),
+            mu_a_by_level,
+            mu_a_cells: finest.mu_a_cells,
             flat_calibration: rs[0].case.spec.surface == solver::Surface::Flat
-                && solved[0].1.k_e_source == solver::K_E_FLAT_CALIBRATED,
+                && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
         });
     }
     (points, incomplete)
@@ -247,47 +259,50 @@ pub struct CurveSummary {
     pub resolved: Option<bool>,
 }
 
+/// The curve points of each material × surface, keyed by (material,
+/// surface), sorted by angle: the one grouping behind `summary.json`'s
+/// curves and the figure.
+fn by_curve(points: &[CurvePoint]) -> BTreeMap<(&str, &str), Vec<&CurvePoint>> {
+    let mut m: BTreeMap<(&str, &str), Vec<&CurvePoint>> = BTreeMap::new();
+    for p in points {
+        m.entry((p.key.material.as_str(), p.key.surface.as_str()))
+            .or_default()
+            .push(p);
+    }
+    for v in m.values_mut() {
+        v.sort_by(|a, b| a.key.angle_deg.total_cmp(&b.key.angle_deg));
+    }
+    m
+}
+
 /// Per material × surface ("material / surface"): range of μa over angle,
 /// its error and whether the variation is resolved.
 pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> {
     let mut out = BTreeMap::new();
-    for (name, pts) in curves(points) {
-        let lo = pts.iter().min_by(|a, b| a.1.total_cmp(&b.1));
-        let hi = pts.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+    for ((material, surface), pts) in by_curve(points) {
+        let value = |p: &&CurvePoint| p.mu_a.value;
+        let lo = pts.iter().min_by(|a, b| value(a).total_cmp(&value(b)));
+        let hi = pts.iter().max_by(|a, b| value(a).total_cmp(&value(b)));
         let (Some(lo), Some(hi)) = (lo, hi) else {
             continue;
         };
-        let errs: Option<Vec<f64>> = pts.iter().map(|p| p.2).collect();
-        let resolved = match (lo.2, hi.2) {
-            (Some(el), Some(eh)) if pts.len() > 1 => Some(hi.1 - lo.1 > el + eh),
+        let errs: Option<Vec<f64>> = pts.iter().map(|p| p.mu_a.err).collect();
+        let resolved = match (lo.mu_a.err, hi.mu_a.err) {
+            (Some(el), Some(eh)) if pts.len() > 1 => Some(hi.mu_a.value - lo.mu_a.value > el + eh),
             _ => None,
         };
         out.insert(
-            name,
+            format!("{material} / {surface}"),
             CurveSummary {
                 points: pts.len(),
-                mu_a_min: lo.1,
-                mu_a_max: hi.1,
+                mu_a_min: lo.mu_a.value,
+                mu_a_max: hi.mu_a.value,
                 mu_a_err_max: errs.map(|e| e.into_iter().fold(0.0, f64::max)),
                 resolved,
             },
         );
     }
     out
-}
-
-/// Curves keyed by "material / surface": (angle, μa, error) sorted by angle.
-pub fn curves(points: &[CurvePoint]) -> BTreeMap<String, Vec<(f64, f64, Option<f64>)>> {
-    let mut m: BTreeMap<String, Vec<(f64, f64, Option<f64>)>> = BTreeMap::new();
-    for p in points {
-        m.entry(format!("{} / {}", p.key.material, p.key.surface))
-            .or_default()
-            .push((p.key.angle_deg, p.mu_a.value, p.mu_a.err));
-    }
-    for v in m.values_mut() {
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
-    }
-    m
 }
 
 /// One panel of the sweep's figure: named series of (angle, value, error).
@@ -309,33 +324,27 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
         y_desc: "K_E (GPa)",
         series: BTreeMap::new(),
     };
-    for p in points {
-        let (x, mu) = (p.key.angle_deg, &p.mu_a);
-        by_material
-            .entry(p.key.material.as_str())
-            .or_insert_with(|| Panel {
-                title: p.key.material.clone(),
-                y_desc: "apparent friction μa (–)",
-                series: BTreeMap::new(),
-            })
-            .series
-            .entry(p.key.surface.clone())
-            .or_default()
-            .push((x, mu.value, mu.err));
-        if p.flat_calibration {
-            k_e.series.entry(p.key.material.clone()).or_default().push((
-                x,
-                p.k_e.value / 1e9,
-                p.k_e.err.map(|e| e / 1e9),
-            ));
+    for ((material, surface), pts) in by_curve(points) {
+        let panel = by_material.entry(material).or_insert_with(|| Panel {
+            title: material.to_string(),
+            y_desc: "apparent friction μa (–)",
+            series: BTreeMap::new(),
+        });
+        let mu = pts
+            .iter()
+            .map(|p| (p.key.angle_deg, p.mu_a.value, p.mu_a.err));
+        panel.series.insert(surface.to_string(), mu.collect());
+        if pts.iter().all(|p| p.flat_calibration) {
+            let gpa = |v: f64| v / 1e9;
+            let ke = pts
+                .iter()
+                .map(|p| (p.key.angle_deg, gpa(p.k_e.value), p.k_e.err.map(gpa)));
+            k_e.series.insert(material.to_string(), ke.collect());
         }
     }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     if !k_e.series.is_empty() {
         panels.push(k_e);
-    }
-    for series in panels.iter_mut().flat_map(|p| p.series.values_mut()) {
-        series.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
     let cols = panels.len().clamp(1, 2);
     let rows = panels.len().div_ceil(2).max(1);
