@@ -7,7 +7,8 @@ use crate::npy::read_grid_npy;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use solver::{
-    CaseSpec, Grid, Island, Isotropic, LatticeKind, Load, Material, Numerics, SolverError, Surface,
+    CaseSpec, Grid, Island, Isotropic, LatticeKind, Load, LoadHistory, Material, Numerics,
+    SolverError, Surface,
 };
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -385,6 +386,82 @@ impl ConvergenceCfg {
     }
 }
 
+/// `[history]`: a load path applied to every case (fretting loops,
+/// proportional loading), PHYSICS.md §5b. Either the turning points
+/// (`tangential_ratios`, optionally `normal_n`) or the `fretting` shorthand.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HistoryCfg {
+    /// Turning points of F/(μP) along the case's force angle (signed),
+    /// joined by straight lines.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_ratios: Option<Vec<f64>>,
+    /// Normal load at each turning point, N (default: `load.normal_n` throughout).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_n: Option<Vec<f64>>,
+    /// Increments per segment between turning points.
+    #[serde(default = "default_steps")]
+    pub steps_per_segment: usize,
+    /// Shorthand: 0 → +A → −A → +A … with `cycles` full cycles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fretting: Option<FrettingCfg>,
+}
+
+/// `history.fretting`: a fretting loop of amplitude A = `amplitude_ratio` μP.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrettingCfg {
+    /// Amplitude of the tangential force, as a fraction of μP (0 < A < 1).
+    pub amplitude_ratio: f64,
+    /// Full cycles after the first loading (+A → −A → +A each).
+    #[serde(default = "one")]
+    pub cycles: usize,
+}
+
+fn default_steps() -> usize {
+    20
+}
+
+/// Most fretting cycles a config may ask for (each is two segments).
+pub const MAX_CYCLES: usize = 1000;
+
+impl HistoryCfg {
+    /// The solver's load path; errors name the config key.
+    pub fn load_history(&self) -> Result<LoadHistory> {
+        let ratios = match (&self.tangential_ratios, &self.fretting) {
+            (Some(_), Some(_)) => bail!(
+                "history: give either tangential_ratios or fretting = {{ amplitude_ratio, cycles }}, not both"
+            ),
+            (None, None) => bail!(
+                "history: give the turning points (tangential_ratios = [0.0, 0.6, -0.6, 0.6]) or fretting = {{ amplitude_ratio = 0.6, cycles = 2 }}"
+            ),
+            (Some(r), None) => r.clone(),
+            (None, Some(f)) => {
+                let a = f.amplitude_ratio;
+                if !(a.is_finite() && a > 0.0 && a < 1.0) {
+                    bail!("history.fretting.amplitude_ratio = {a}: must be above 0 and below 1 (the amplitude as a fraction of μP; at 1 the sphere slides)");
+                }
+                if !(1..=MAX_CYCLES).contains(&f.cycles) {
+                    bail!("history.fretting.cycles = {}: must be 1 to {MAX_CYCLES}", f.cycles);
+                }
+                if self.normal_n.is_some() {
+                    bail!("history.normal_n: not with the fretting shorthand (its normal load is load.normal_n); give tangential_ratios instead");
+                }
+                let mut r = vec![0.0, a];
+                for _ in 0..f.cycles {
+                    r.extend([-a, a]);
+                }
+                r
+            }
+        };
+        Ok(LoadHistory {
+            tangential_ratios: ratios,
+            normal_forces_n: self.normal_n.clone(),
+            steps_per_segment: self.steps_per_segment,
+        })
+    }
+}
+
 /// Points per side of ladder level `level` on a grid of `n`: n·2^(level/2),
 /// odd levels rounded to the nearest 5-smooth number (2^a 3^b 5^c: fast
 /// FFT sizes; 384 → 540, 256 → 360), so the cell-size ratio is √2 to
@@ -441,6 +518,9 @@ pub struct Config {
     /// `[convergence]` (left out of the echo when it is the default, as `[run]`).
     #[serde(default, skip_serializing_if = "ConvergenceCfg::is_default")]
     pub convergence: ConvergenceCfg,
+    /// `[history]`: a load path for every case (none: one monotonic step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<HistoryCfg>,
     /// Directory that relative paths in the config (height maps) start from.
     #[serde(skip)]
     pub base_dir: std::path::PathBuf,
@@ -563,10 +643,13 @@ fn config_key(param: &str) -> String {
         "load.normal_force_n" => "load.normal_n",
         "load.angle_deg" => "sweep.angles_deg",
         other => {
+            if let Some(rest) = other.strip_prefix("history.normal_forces_n") {
+                return format!("history.normal_n{rest}");
+            }
             return match other.strip_prefix("numerics.") {
                 Some(rest) => format!("solver.{rest}"),
                 None => other.to_string(),
-            }
+            };
         }
     };
     key.to_string()
@@ -693,6 +776,9 @@ impl Config {
         }
         self.check_unique(&self.sweep.angles_deg.values()?)?;
         self.check_ladder()?;
+        if let Some(h) = &self.history {
+            h.load_history()?;
+        }
         // Whether the workers fit in this machine's memory is checked where
         // they start (`memory::check_fits`), not here.
         for (key, spec) in self.cases()? {
@@ -796,6 +882,13 @@ impl Config {
 
     /// The spec of a resolved material and surface at one angle.
     fn spec_of(&self, material: Material, surface: Surface, angle_deg: f64) -> CaseSpec {
+        let history = self.load_history();
+        // With a load path, the case's own ratio is the path's last one (its
+        // final state is reduced like a monotonic case: μa, K_E calibration).
+        let tangential_ratio = match &history {
+            Some(h) => h.tangential_ratios.last().map_or(0.0, |r| r.max(0.0)),
+            None => self.load.tangential_ratio,
+        };
         CaseSpec {
             material,
             surface,
@@ -804,7 +897,7 @@ impl Config {
                 indenter_radius_m: self.indenter.radius_mm * 1e-3,
                 normal_force_n: self.load.normal_n,
                 friction: self.load.friction,
-                tangential_ratio: self.load.tangential_ratio,
+                tangential_ratio,
                 angle_deg,
             },
             numerics: Numerics {
@@ -815,7 +908,14 @@ impl Config {
                 coupling_tolerance: self.solver.coupling_tolerance,
                 max_coupling_iterations: self.solver.max_coupling_iterations,
             },
+            history,
         }
+    }
+
+    /// The load path of `[history]`, if any. A malformed one gives `None`
+    /// here; [`Config::check`] reports it by key before any case is made.
+    pub fn load_history(&self) -> Option<LoadHistory> {
+        self.history.as_ref().and_then(|h| h.load_history().ok())
     }
 
     /// All cases of the sweep in a fixed order: materials × surfaces × angles

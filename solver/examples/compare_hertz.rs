@@ -216,6 +216,7 @@ fn slip(n: usize, args: &Args, coupling: bool) {
             coupling_tolerance: 1e-8,
             max_coupling_iterations: 50,
         },
+        history: None,
     };
     let mut cache = KernelCache::new();
     let _ = cache.resident(&spec).expect("kernel");

@@ -4,10 +4,10 @@
 //! `spec`, `kernels`, `normal`, `coupling` and `results`.
 
 use crate::error::SolverError;
-use crate::kernels::KernelCache;
+use crate::kernels::{KernelCache, Resident};
 use crate::normal::NormalProblem;
 use crate::results::{reduce, CaseOutput};
-use crate::spec::CaseSpec;
+use crate::spec::{CaseSpec, LoadHistory};
 
 /// Fails when any cell of the outermost ring carries pressure: the contact
 /// then reaches the edge of the domain and the result would be wrong.
@@ -30,6 +30,9 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     let started = std::time::Instant::now();
     let n = spec.grid.n;
     let h0 = spec.initial_gap();
+    if let Some(history) = &spec.history {
+        return solve_history_case(spec, history, res, &h0, started, kernel_seconds);
+    }
     let normal = res.solve_normal(&NormalProblem {
         tolerance: spec.numerics.tolerance,
         max_iterations: spec.numerics.max_iterations,
@@ -38,5 +41,51 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     check_inside(n, &normal.p)?;
     let state = crate::coupling::solve_partial_slip(res, spec, &h0, normal)?;
     check_inside(n, &state.p)?;
-    reduce(spec, &mut res.operator, state, started, kernel_seconds)
+    reduce(
+        spec,
+        &mut res.operator,
+        state,
+        started,
+        kernel_seconds,
+        None,
+    )
+}
+
+/// A case with a load path: frictionless normal loading to the first
+/// turning point's load, the increments, and the scalars and fields of the
+/// final state with the path's table.
+fn solve_history_case(
+    spec: &CaseSpec,
+    history: &LoadHistory,
+    res: &mut Resident,
+    h0: &[f64],
+    started: std::time::Instant,
+    kernel_seconds: f64,
+) -> Result<CaseOutput, SolverError> {
+    let n = spec.grid.n;
+    let points = history.turning_points(&spec.load);
+    let normal = res.solve_normal(&NormalProblem {
+        tolerance: spec.numerics.tolerance,
+        max_iterations: spec.numerics.max_iterations,
+        ..NormalProblem::new(h0, points[0].0)
+    })?;
+    check_inside(n, &normal.p)?;
+    let solved =
+        crate::history::solve_history(res, spec, history, h0, normal, |p| check_inside(n, p))?;
+    // The final state is reduced as a case under the path's last load.
+    let &(p_last, f_last) = points.last().expect("validated: at least one point");
+    let mut last_spec = spec.clone();
+    last_spec.load.normal_force_n = p_last;
+    last_spec.load.tangential_ratio = (f_last / (spec.load.friction * p_last)).max(0.0);
+    let converged = solved.converged;
+    let mut out = reduce(
+        &last_spec,
+        &mut res.operator,
+        solved.last,
+        started,
+        kernel_seconds,
+        Some(solved.output),
+    )?;
+    out.scalars.converged &= converged;
+    Ok(out)
 }

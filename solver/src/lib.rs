@@ -23,6 +23,7 @@
 //!         angle_deg: 30.0,
 //!     },
 //!     numerics: Numerics::default(),
+//!     history: None,
 //! };
 //! let mut cache = KernelCache::new(); // keeps the kernel for the next case
 //! let out = solve_case(&spec, &mut cache).unwrap();
@@ -43,6 +44,7 @@ pub mod fft2;
 #[doc(hidden)]
 pub mod geometry;
 mod grid;
+mod history;
 #[doc(hidden)]
 pub mod influence;
 mod kernels;
@@ -62,6 +64,7 @@ pub mod window;
 pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
+pub use history::{HistoryOutput, HistoryStep, DISSIPATION_DEFINITION};
 pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
@@ -71,5 +74,5 @@ pub use results::{
     APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS, K_E_DEFINITION,
     K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
-pub use spec::{CaseSpec, Load, Numerics, MAX_GRID_POINTS};
+pub use spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
 pub use surface::{Island, LatticeKind, Surface};

@@ -92,6 +92,7 @@ mod tests {
                 angle_deg: 0.0,
             },
             numerics: crate::Numerics::default(),
+            history: None,
         }
     }
 

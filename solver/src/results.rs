@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::coupling::ContactState;
 use crate::error::SolverError;
 use crate::geometry::{equivalent_radius, hull_area, subcell_hull_area};
+use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
 use crate::spec::{CaseSpec, Load};
@@ -86,6 +87,10 @@ pub struct CaseScalars {
     /// (0 when it was already resident), s.
     #[serde(default)]
     pub kernel_seconds: f64,
+    /// The load path's table and reductions, for a case with a history
+    /// (the other scalars then describe the path's final state).
+    #[serde(default)]
+    pub history: Option<HistoryOutput>,
 }
 
 /// Surface fields of a solved case, each `n x n`, row-major `[iy][ix]` (y rows, x columns).
@@ -221,14 +226,18 @@ pub const MIN_RESOLVED_CELLS: f64 = 2.0;
 
 /// The fields and scalars of a solved case: total displacements from all
 /// tractions, radii, shifts, forces and μa with the isotropic-equivalent K_E.
-/// `started` is when the solve began (for `seconds`).
+/// `started` is when the solve began (for `seconds`). With a load path's
+/// `history`, a final state without a resolved slip annulus (everything
+/// sticks, as under proportional loading) is a result, with μa `None`.
 pub(crate) fn reduce(
     spec: &CaseSpec,
     op: &mut Operator,
     state: ContactState,
     started: std::time::Instant,
     kernel_seconds: f64,
+    history: Option<HistoryOutput>,
 ) -> Result<CaseOutput, SolverError> {
+    let is_history = history.is_some();
     let ContactState {
         p,
         approach,
@@ -284,7 +293,7 @@ pub(crate) fn reduce(
             ),
         });
     }
-    if fnorm > 0.0 && c < min_radius {
+    if fnorm > 0.0 && c < min_radius && !is_history {
         return Err(SolverError::SlipUnresolved {
             detail: format!(
                 "the stick zone, c = {c:.3e} m, spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m (F/μP = {} leaves almost no stick)",
@@ -354,8 +363,15 @@ pub(crate) fn reduce(
         tangential: tan_report,
         seconds: started.elapsed().as_secs_f64(),
         kernel_seconds,
+        history,
     };
-    if fnorm > 0.0 {
+    let annulus = c < a && c_sub < a_sub && c >= min_radius;
+    if fnorm > 0.0 && is_history {
+        if annulus {
+            s.mu_a = Some(mu_apparent(&s, load, s.k_e));
+            s.mu_a_cells = mu_apparent_cells(&s, load, s.k_e_cells);
+        }
+    } else if fnorm > 0.0 {
         if c >= a {
             let slipping = contact_area - stick_area;
             return Err(SolverError::SlipUnresolved {

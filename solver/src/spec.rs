@@ -69,6 +69,115 @@ impl Default for Numerics {
     }
 }
 
+/// Most increments a load history may ask for (all segments together): a
+/// bound against a typo (`steps_per_segment = 1e6`), far above the few
+/// hundred a fretting study needs.
+pub const MAX_HISTORY_STEPS: usize = 100_000;
+
+/// A load path: turning points of the normal load and of the tangential
+/// force, joined by straight lines, each segment split into
+/// `steps_per_segment` increments (a fretting loop, a proportional
+/// loading). The state before the path is frictionless normal contact under
+/// the first turning point's normal load; if the first tangential ratio is
+/// not zero, the path starts with a segment from zero force to it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoadHistory {
+    /// Turning points of F/(μP) along the case's force direction (signed:
+    /// negative is against it), P being the normal load at that point.
+    pub tangential_ratios: Vec<f64>,
+    /// Turning points of the normal load, N, one per tangential ratio;
+    /// `None`: constant, the case's `load.normal_force_n`.
+    pub normal_forces_n: Option<Vec<f64>>,
+    /// Increments per segment between turning points.
+    pub steps_per_segment: usize,
+}
+
+impl LoadHistory {
+    /// The turning points as (P, F along the force direction) in N,
+    /// starting from zero tangential force.
+    pub fn turning_points(&self, load: &Load) -> Vec<(f64, f64)> {
+        let normal = |j: usize| match &self.normal_forces_n {
+            Some(v) => v[j],
+            None => load.normal_force_n,
+        };
+        let mut pts: Vec<(f64, f64)> = (0..self.tangential_ratios.len())
+            .map(|j| {
+                let p = normal(j);
+                (p, self.tangential_ratios[j] * load.friction * p)
+            })
+            .collect();
+        if let Some(&(p0, f0)) = pts.first() {
+            if f0 != 0.0 {
+                pts.insert(0, (p0, 0.0));
+            }
+        }
+        pts
+    }
+
+    /// Rejects impossible paths, naming `history.<key>[index]`.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        let n = self.tangential_ratios.len();
+        if n == 0 {
+            return Err(SolverError::invalid(
+                "history.tangential_ratios",
+                "needs at least one turning point",
+            ));
+        }
+        for (j, &r) in self.tangential_ratios.iter().enumerate() {
+            if !r.is_finite() {
+                return Err(SolverError::invalid(
+                    &format!("history.tangential_ratios[{j}]"),
+                    format!("must be finite, got {r}"),
+                ));
+            }
+            if r.abs() >= 1.0 {
+                return Err(SolverError::invalid(
+                    &format!("history.tangential_ratios[{j}]"),
+                    format!(
+                        "|F|/μP = {} reaches or exceeds the friction limit: the sphere slides as a whole (gross sliding); keep every turning point below 1 in magnitude",
+                        r.abs()
+                    ),
+                ));
+            }
+        }
+        if let Some(v) = &self.normal_forces_n {
+            if v.len() != n {
+                return Err(SolverError::invalid(
+                    "history.normal_forces_n",
+                    format!(
+                        "has {} turning points but history.tangential_ratios has {n}; give one normal load per turning point",
+                        v.len()
+                    ),
+                ));
+            }
+            for (j, &p) in v.iter().enumerate() {
+                positive(
+                    &format!("history.normal_forces_n[{j}]"),
+                    p,
+                    "the normal load",
+                )?;
+            }
+        }
+        if self.steps_per_segment == 0 {
+            return Err(SolverError::invalid(
+                "history.steps_per_segment",
+                "must be at least 1",
+            ));
+        }
+        let total = self.steps_per_segment.saturating_mul(n);
+        if total > MAX_HISTORY_STEPS {
+            return Err(SolverError::invalid(
+                "history.steps_per_segment",
+                format!(
+                    "{} increments per segment over {n} turning points make {total} increments, more than {MAX_HISTORY_STEPS}",
+                    self.steps_per_segment
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Everything that defines one case.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseSpec {
@@ -82,6 +191,10 @@ pub struct CaseSpec {
     pub load: Load,
     /// Solver settings.
     pub numerics: Numerics,
+    /// A load path (fretting, proportional loading); `None`: one monotonic
+    /// step of the tangential force from zero at constant normal load.
+    #[serde(default)]
+    pub history: Option<LoadHistory>,
 }
 
 fn positive(param: &str, v: f64, what: &str) -> Result<(), SolverError> {
@@ -237,7 +350,21 @@ impl CaseSpec {
         // 1e-300 m sphere gave δz = 4.6e296 m, #20 item 8). Hertz's radius
         // with the isotropic-equivalent constants is the scale; patterns
         // and anisotropy change it by tens of per cent, not by cells.
-        let a_hertz = (3.0 * load.normal_force_n * load.indenter_radius_m
+        // Under a load history the smallest normal load sets the smallest contact.
+        let mut normal_min = load.normal_force_n;
+        if let Some(h) = &self.history {
+            h.validate()?;
+            if let Some(v) = &h.normal_forces_n {
+                normal_min = v.iter().cloned().fold(f64::INFINITY, f64::min);
+            }
+            if h.tangential_ratios.iter().any(|&r| r != 0.0) && load.friction == 0.0 {
+                return Err(SolverError::invalid(
+                    "load.friction",
+                    "a tangential force needs a positive friction coefficient",
+                ));
+            }
+        }
+        let a_hertz = (3.0 * normal_min * load.indenter_radius_m
             / (4.0 * self.material.equivalent.plane_strain()))
         .cbrt();
         let min = crate::results::MIN_RESOLVED_CELLS * grid.dx;

@@ -22,6 +22,7 @@ fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64
             coupling_tolerance: 1e-8,
             ..Numerics::default()
         },
+        history: None,
     }
 }
 

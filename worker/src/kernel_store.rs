@@ -364,6 +364,7 @@ mod tests {
                 coupling_tolerance: 1e-8,
                 max_coupling_iterations: 5,
             },
+            history: None,
         }
     }
 

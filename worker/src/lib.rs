@@ -386,6 +386,7 @@ mod tests {
                 coupling_tolerance: 1e-6,
                 max_coupling_iterations: 5,
             },
+            history: None,
         }
     }
 

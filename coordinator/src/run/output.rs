@@ -605,6 +605,7 @@ mod tests {
                 angle_deg: 30.0,
             },
             numerics: super::super::plan::tests::quick_numerics(),
+            history: None,
         };
         let key = CaseKey::new("Cu(111)", surface_name, 30.0);
         let mut plan = super::super::plan::Plan::new(vec![(key, spec)]);

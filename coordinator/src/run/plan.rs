@@ -186,6 +186,7 @@ pub(crate) mod tests {
                 angle_deg: angle,
             },
             numerics: quick_numerics(),
+            history: None,
         }
     }
 

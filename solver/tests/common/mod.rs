@@ -24,5 +24,6 @@ pub fn table_1a_fe(n: usize, spacing_um: f64, coupling: bool, ratio: f64) -> Cas
             coupling_tolerance: 1e-8,
             ..Numerics::default()
         },
+        history: None,
     }
 }
