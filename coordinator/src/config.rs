@@ -1154,6 +1154,68 @@ angles_deg = { start = 0, stop = 90, step = 45 }
     }
 
     #[test]
+    fn issue16_bad_histories_name_their_key() {
+        let with = |h: &str| format!("{BASE}\n[history]\n{h}\n");
+        let cases: [(&str, &str); 10] = [
+            (
+                "tangential_ratios = [0.0, 0.6, nan]",
+                "history.tangential_ratios[2]: must be finite",
+            ),
+            (
+                "tangential_ratios = [0.0, 1.0]",
+                "history.tangential_ratios[1]",
+            ),
+            ("tangential_ratios = [0.0, -1.5]", "friction limit"),
+            (
+                "tangential_ratios = [0.0, 0.5]\nnormal_n = [20.0]",
+                "history.normal_n: has 1 turning points",
+            ),
+            (
+                "tangential_ratios = [0.0, 0.5]\nnormal_n = [20.0, -1.0]",
+                "history.normal_n[1]",
+            ),
+            (
+                "tangential_ratios = [0.0, 0.5]\nsteps_per_segment = 0",
+                "history.steps_per_segment: must be at least 1",
+            ),
+            (
+                "tangential_ratios = []",
+                "history.tangential_ratios: needs at least one",
+            ),
+            (
+                "fretting = { amplitude_ratio = 1.0 }",
+                "history.fretting.amplitude_ratio = 1",
+            ),
+            (
+                "fretting = { amplitude_ratio = 0.5, cycles = 0 }",
+                "history.fretting.cycles = 0",
+            ),
+            ("steps_per_segment = 5", "history: give the turning points"),
+        ];
+        for (h, expect) in cases {
+            let e = err(&with(h), &[]);
+            assert!(e.contains(expect), "{h}: {e}");
+        }
+        // The shorthand expands to 0 → +A → (−A → +A) × cycles.
+        let c = Config::parse(
+            &with("fretting = { amplitude_ratio = 0.5, cycles = 2 }"),
+            &[],
+        )
+        .unwrap();
+        let h = c.load_history().unwrap();
+        assert_eq!(h.tangential_ratios, vec![0.0, 0.5, -0.5, 0.5, -0.5, 0.5]);
+        assert_eq!(h.steps_per_segment, 20);
+        let (_, spec) = &c.cases().unwrap()[0];
+        assert_eq!(spec.history.as_ref(), Some(&h));
+        assert_eq!(spec.load.tangential_ratio, 0.5, "the path's last ratio");
+        // Without [history], no path.
+        assert!(Config::parse(BASE, &[]).unwrap().cases().unwrap()[0]
+            .1
+            .history
+            .is_none());
+    }
+
+    #[test]
     fn impossible_values_name_their_key() {
         let cases: [(&str, &str, &str); 9] = [
             (

@@ -27,6 +27,21 @@ pub struct CaseJson<'a> {
     grid_points: usize,
     spacing_m: f64,
     spec: &'a CaseSpec,
+    /// With a load history: energy dissipated over the last full cycle, J.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dissipated_energy_per_cycle_j: Option<f64>,
+    /// With a load history: the loop's area over the same cycle, J.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    loop_area_per_cycle_j: Option<f64>,
+    /// With a load history: stiffness right after the last reversal, N/m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reversal_stiffness_n_per_m: Option<f64>,
+    /// With a load history: δt along the force where F crosses zero on unloading, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    residual_delta_t_m: Option<f64>,
+    /// With a load history: how the dissipated energy is computed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dissipation_definition: Option<&'static str>,
 }
 
 /// Options of `mpcontact solve`.
@@ -125,6 +140,7 @@ impl Solved {
     /// serde value).
     pub fn case_json(&self) -> CaseJson<'_> {
         let c = &self.case;
+        let h = self.scalars.history.as_ref();
         CaseJson {
             material: &c.material,
             surface: &c.surface,
@@ -136,6 +152,11 @@ impl Solved {
             grid_points: c.spec.grid.n,
             spacing_m: c.spec.grid.dx,
             spec: &c.spec,
+            dissipated_energy_per_cycle_j: h.and_then(|h| h.dissipated_energy_per_cycle_j),
+            loop_area_per_cycle_j: h.and_then(|h| h.loop_area_per_cycle_j),
+            reversal_stiffness_n_per_m: h.and_then(|h| h.reversal_stiffness_n_per_m),
+            residual_delta_t_m: h.and_then(|h| h.residual_delta_t_m),
+            dissipation_definition: h.map(|_| solver::DISSIPATION_DEFINITION),
         }
     }
 }
@@ -185,6 +206,11 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
     // system font) is a warning, not a lost result.
     let c = &solved.case;
     let title = format!("{}, {}, ψ = {}°", c.material, c.surface, c.angle_deg);
+    if let Some(h) = &solved.scalars.history {
+        for w in crate::history_out::write_history(out, h, &title)? {
+            eprintln!("warning: {w}");
+        }
+    }
     if let Err(e) =
         crate::maps::write_maps(out, &title, &solved.fields, &solved.scalars, c.spec.grid.dx)
     {

@@ -72,6 +72,15 @@ fn accepted_keys() -> BTreeSet<String> {
     };
     // Non-default, so that the echo holds the section.
     c.convergence = coordinator::config::ConvergenceCfg { levels: 3 };
+    c.history = Some(coordinator::config::HistoryCfg {
+        tangential_ratios: Some(vec![0.0, 0.5]),
+        normal_n: Some(vec![1.0, 2.0]),
+        steps_per_segment: 10,
+        fretting: Some(coordinator::config::FrettingCfg {
+            amplitude_ratio: 0.5,
+            cycles: 2,
+        }),
+    });
     let v = toml::Value::try_from(&c).unwrap();
     let mut keys = BTreeSet::new();
     walk("", &v, &mut keys);

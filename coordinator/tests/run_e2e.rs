@@ -1050,3 +1050,53 @@ fn a_refine_ladder_reports_levels_estimate_and_error() {
     assert_eq!(s["curves"]["Cu / circle-B"]["points"], 1);
     assert!(o.join("mu_a_vs_angle.png").exists());
 }
+
+/// Issue #16: a sweep with a `[history]` sends the path to the workers and
+/// gets the table back: `curves.csv` gains the energy per cycle, every case
+/// has its `history.csv` and loop, and the worker's numbers are those of
+/// `mpcontact solve` on the same case, to the bit.
+#[test]
+fn issue16_a_fretting_sweep_reports_energy_per_cycle_and_per_case_loops() {
+    let dir = scratch("fretting");
+    let text = format!(
+        "{CONFIG}\n[history]\nfretting = {{ amplitude_ratio = 0.5, cycles = 1 }}\nsteps_per_segment = 4\n"
+    );
+    std::fs::write(dir.join("sweep.toml"), &text).unwrap();
+    let mut cmd = sweep_cmd(&dir, "out", 2, "f");
+    cmd.args(["--set", "sweep.materials=[\"Cu\"]"]);
+    check_ok(&cmd.output().unwrap(), "fretting sweep");
+    let o = dir.join("out");
+    let curves = read_csv(&o.join("curves.csv"));
+    let col = |name: &str| curves[0].iter().position(|h| h == name).unwrap();
+    assert_eq!(curves.len() - 1, 6, "Cu × 2 surfaces × 3 angles");
+    for c in &curves[1..] {
+        let e: f64 = c[col("dissipated_j")].parse().unwrap();
+        assert!(e > 0.0, "{c:?}");
+    }
+    let case = o.join("fields/Cu/circle-A/045.0");
+    let table = read_csv(&case.join("history.csv"));
+    assert_eq!(table.len(), 1 + 1 + 3 * 4, "header, step 0, three segments of 4");
+    assert!(case.join("hysteresis.png").is_file() && case.join("hysteresis.svg").is_file());
+    // The same case in-process.
+    let solved = dir.join("solve");
+    let out = Command::new(EXE)
+        .arg("solve")
+        .arg(dir.join("sweep.toml"))
+        .args(["--material", "Cu", "--surface", "circle-A", "--angle-deg", "45", "--out"])
+        .arg(&solved)
+        .output()
+        .unwrap();
+    check_ok(&out, "solve");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(solved.join("case.json")).unwrap()).unwrap();
+    let e_solve = json["dissipated_energy_per_cycle_j"].as_f64().unwrap();
+    let row = curves
+        .iter()
+        .find(|c| c[col("surface")] == "circle-A" && c[col("angle_deg")] == "45")
+        .unwrap();
+    assert_eq!(row[col("dissipated_j")].parse::<f64>().unwrap(), e_solve);
+    assert_eq!(
+        std::fs::read_to_string(solved.join("history.csv")).unwrap(),
+        std::fs::read_to_string(case.join("history.csv")).unwrap()
+    );
+}

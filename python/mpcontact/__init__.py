@@ -67,6 +67,41 @@ class Result:
         c = (np.arange(n) - (n - 1) / 2.0) * self.spacing_m
         return c, c.copy()
 
+    def history(self):
+        """The load path's table of a case with ``[history]`` (fretting,
+        proportional loading), else ``None``: a dict of 1-D arrays named as
+        the columns of the CLI's ``history.csv`` (``step``,
+        ``normal_force_n``, ``fx_n``, ``fy_n``, ``delta_x_m``, ``delta_y_m``,
+        ``delta_z_m``, ``contact_area_m2``, ``stick_area_m2``,
+        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``).
+        The per-cycle energy, reversal stiffness and residual shift are in
+        ``scalars`` as in ``case.json``."""
+        h = self.scalars.get("history")
+        if h is None:
+            return None
+        import numpy as np
+
+        steps = h["steps"]
+
+        def col(get, dtype=np.float64):
+            return np.array([get(r) for r in steps], dtype=dtype)
+
+        return {
+            "step": col(lambda r: r["step"], np.int64),
+            "normal_force_n": col(lambda r: r["normal_force_n"]),
+            "fx_n": col(lambda r: r["force_n"][0]),
+            "fy_n": col(lambda r: r["force_n"][1]),
+            "delta_x_m": col(lambda r: r["delta_t_m"][0]),
+            "delta_y_m": col(lambda r: r["delta_t_m"][1]),
+            "delta_z_m": col(lambda r: r["delta_z_m"]),
+            "contact_area_m2": col(lambda r: r["contact_area_m2"]),
+            "stick_area_m2": col(lambda r: r["stick_area_m2"]),
+            "stick_radius_m": col(lambda r: r["stick_radius_m"]),
+            "dissipated_j": col(lambda r: r["dissipated_j"]),
+            "segment": col(lambda r: r["segment"], np.int64),
+            "converged": col(lambda r: r["converged"], bool),
+        }
+
     def __repr__(self):
         s = self.scalars
         return (

@@ -167,3 +167,38 @@ def _dict_config(points=64, ratio=0.6, angle=0.0, spacing_um=None):
         "sweep": {"materials": ["Fe"], "surfaces": ["flat"], "angles_deg": [angle]},
         "solver": {"coupling": False, "tolerance": 1e-10, "tangential_tolerance": 1e-6},
     }
+
+
+def test_a_fretting_history_equals_the_cli_table_bit_for_bit(tmp_path, cli_solve):
+    path = tmp_path / "fretting.toml"
+    path.write_text(
+        mindlin_text(ratio=0.6)
+        + "\n[history]\nfretting = { amplitude_ratio = 0.6, cycles = 1 }\nsteps_per_segment = 4\n"
+    )
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert_same_as_cli(res, case_json, cli_dir)
+    h = res.history()
+    lines = (cli_dir / "history.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert list(h) == header
+    assert len(h["step"]) == len(lines) - 1 == 1 + 3 * 4
+    for k, name in enumerate(header):
+        cli_col = [line.split(",")[k] for line in lines[1:]]
+        if name == "converged":
+            assert [str(v).lower() for v in h[name]] == cli_col
+        else:
+            # The CLI writes shortest round-trip digits: parsing gives the bits.
+            assert np.array(cli_col, dtype=np.float64).tobytes() == h[name].astype(
+                np.float64
+            ).tobytes(), name
+    # Energy per cycle positive and equal to the sum over the cycle's rows.
+    s = res.scalars
+    assert s["dissipated_energy_per_cycle_j"] > 0
+    assert s["dissipated_energy_per_cycle_j"] == pytest.approx(
+        h["dissipated_j"][5:].sum(), rel=1e-12
+    )
+    # Without a history, no table.
+    plain = tmp_path / "plain.toml"
+    plain.write_text(mindlin_text(ratio=0.6))
+    assert mpcontact.solve(mpcontact.Config.from_toml(plain)).history() is None

@@ -228,6 +228,7 @@ pub(crate) fn solve_history(
             } else {
                 1.0
             };
+            let start = (&last.tangential.qx[..], &last.tangential.qy[..]);
             let state = solve_step(
                 res,
                 spec,
@@ -237,7 +238,7 @@ pub(crate) fn solve_history(
                     normal_force_n: p_k,
                     force,
                     previous: Some(Previous {
-                        q: (&last.tangential.qx, &last.tangential.qy),
+                        start,
                         u: (&ux, &uy),
                         p0: &p0,
                     }),
@@ -295,6 +296,9 @@ pub(crate) fn solve_history(
         }
         turning_steps.push(rows.len() - 1);
     }
+    // The final state's shift is δt from the start of the path, not the
+    // last increment's.
+    last.tangential.shift = delta_t;
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;

@@ -252,6 +252,10 @@ impl CaseSpec {
 
     /// Rejects impossible inputs with the name of the offending parameter.
     pub fn validate(&self) -> Result<(), SolverError> {
+        // The path first: its ratios set the case's own (the last one).
+        if let Some(h) = &self.history {
+            h.validate()?;
+        }
         let grid = &self.grid;
         if grid.n < 8 || grid.n > MAX_GRID_POINTS {
             return Err(SolverError::invalid(
@@ -353,7 +357,6 @@ impl CaseSpec {
         // Under a load history the smallest normal load sets the smallest contact.
         let mut normal_min = load.normal_force_n;
         if let Some(h) = &self.history {
-            h.validate()?;
             if let Some(v) = &h.normal_forces_n {
                 normal_min = v.iter().cloned().fold(f64::INFINITY, f64::min);
             }

@@ -167,6 +167,13 @@ fn mindlin_deresiewicz_fretting_loops_at_0_6_and_0_9_mu_p() {
             "residual {res:e} vs {res_cf:e}"
         );
         assert!(h.force_error_max < 1e-8, "Σ q ΔA = F at every step");
+        // The case's scalars describe the final state (+Q* after reloading,
+        // Masing: the first loading's state): δt from the start of the path,
+        // and μa (Eq. 19) = μ as after a monotonic step.
+        let last = h.steps.last().unwrap();
+        assert_eq!(out.scalars.delta_t_m, along(&h, last.delta_t_m));
+        let mu_a = out.scalars.mu_a.unwrap();
+        assert!((mu_a / MU - 1.0).abs() < 0.01, "μa {mu_a} after the cycles");
         println!(
             "A = {amplitude}: worst branch error {worst:.2e}, Masing {masing:.2e} δ*, ΔW {e:.5e} J (closed form {e_cf:.5e}, {:+.3}%), loop area {area:.5e} J ({:.1e}), k {k:.5e} N/m (secant closed form {k_cf:.5e}, {:+.3}%), residual {res:.5e} m ({res_cf:.5e}, {:+.3}%), tangential iterations {}",
             100.0 * (e / e_cf - 1.0),

@@ -242,6 +242,20 @@ fn write_outputs(
     summary.convergence_levels = levels;
     summary.incomplete_points = incomplete;
     summary.curves = output::curve_summaries(&points);
+    // Cases with a load history: their table and loop beside their fields.
+    for r in &rows {
+        let Some(h) = r.scalars.as_ref().and_then(|s| s.history.as_ref()) else {
+            continue;
+        };
+        let key = &r.case.key;
+        let title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
+        match crate::history_out::write_history(&output::fields_dir(dir, key), h, &title) {
+            Ok(warnings) => summary.output_warnings.extend(warnings),
+            Err(e) => summary
+                .output_warnings
+                .push(format!("history of {key}: {e:#}")),
+        }
+    }
     for name in ["mu_a_vs_angle.png", "mu_a_vs_angle.svg"] {
         if let Err(e) = output::plot_curves(&dir.join(name), &points) {
             summary.output_warnings.push(format!("{name}: {e:#}"));

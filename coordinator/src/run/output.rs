@@ -153,6 +153,9 @@ pub struct CurvePoint {
     /// A flat-surface case whose K_E was calibrated on itself (anisotropic
     /// material): its K_E(ψ) is the calibration curve.
     pub flat_calibration: bool,
+    /// Energy dissipated per load cycle (cases with a `[history]` that
+    /// closes a cycle), J: best value and error bar over the levels.
+    pub dissipated: Option<Estimate>,
 }
 
 /// The curve points of `rows`: each material × surface × angle whose
@@ -204,6 +207,14 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             continue;
         };
         let (_, finest) = solved[solved.len() - 1];
+        let dissipated = solved
+            .iter()
+            .map(|&(h, s)| {
+                let e = s.history.as_ref()?.dissipated_energy_per_cycle_j?;
+                Some((h, e))
+            })
+            .collect::<Option<Vec<_>>>()
+            .and_then(|v| estimate(&v));
         points.push(CurvePoint {
             key,
             mu_a,
@@ -212,18 +223,28 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             mu_a_cells: finest.mu_a_cells,
             flat_calibration: rs[0].case.spec.surface == solver::Surface::Flat
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
+            dissipated,
         });
     }
     (points, incomplete)
 }
 
-/// Text of `curves.csv`.
+/// Columns `curves.csv` gains when the sweep has a load history.
+pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
+
+/// Text of `curves.csv` (with [`CURVES_HISTORY_COLUMNS`] when any point
+/// has a dissipated energy per cycle).
 pub fn curves_csv(points: &[CurvePoint]) -> String {
+    let history = points.iter().any(|p| p.dissipated.is_some());
     let mut out = String::from(CURVES_HEADER);
+    if history {
+        out.push(',');
+        out.push_str(CURVES_HISTORY_COLUMNS);
+    }
     out.push('\n');
     for p in points {
         let by_level: Vec<String> = p.mu_a_by_level.iter().map(|&v| fmt_f64(v)).collect();
-        let _ = writeln!(
+        let _ = write!(
             out,
             "{},{},{},{},{},{},{},{},{},{},{}",
             csv_field(&p.key.material),
@@ -238,6 +259,15 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
             by_level.join(";"),
             opt(p.mu_a_cells),
         );
+        if history {
+            let _ = write!(
+                out,
+                ",{},{}",
+                opt(p.dissipated.as_ref().map(|d| d.value)),
+                opt(p.dissipated.as_ref().and_then(|d| d.err)),
+            );
+        }
+        out.push('\n');
     }
     out
 }
@@ -342,7 +372,31 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
             k_e.series.insert(material.to_string(), ke.collect());
         }
     }
+    // Energy per cycle (load histories): one panel per material, in μJ.
+    let mut energy: BTreeMap<&str, Panel> = BTreeMap::new();
+    for ((material, surface), pts) in by_curve(points) {
+        let uj = |v: f64| v * 1e6;
+        let e: Vec<(f64, f64, Option<f64>)> = pts
+            .iter()
+            .filter_map(|p| {
+                let d = p.dissipated.as_ref()?;
+                Some((p.key.angle_deg, uj(d.value), d.err.map(uj)))
+            })
+            .collect();
+        if !e.is_empty() {
+            energy
+                .entry(material)
+                .or_insert_with(|| Panel {
+                    title: format!("{material}: energy per cycle"),
+                    y_desc: "dissipated per cycle (μJ)",
+                    series: BTreeMap::new(),
+                })
+                .series
+                .insert(surface.to_string(), e);
+        }
+    }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
+    panels.extend(energy.into_values());
     if !k_e.series.is_empty() {
         panels.push(k_e);
     }

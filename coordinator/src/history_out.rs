@@ -1,0 +1,225 @@
+//! The files of a case with a load history: `history.csv` (one row per
+//! increment) and the hysteresis loop (F versus δt along the force
+//! direction, one line per cycle) as PNG and SVG. Used by `mpcontact solve`
+//! and, per case, by a sweep; computes nothing the solver did not.
+
+use crate::run::fmt_f64;
+use anyhow::Result;
+use plotters::prelude::*;
+use solver::HistoryOutput;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Header of `history.csv`.
+pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged";
+
+/// Text of `history.csv`.
+pub fn history_csv(h: &HistoryOutput) -> String {
+    let mut out = String::from(HISTORY_HEADER);
+    out.push('\n');
+    for r in &h.steps {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.step,
+            fmt_f64(r.normal_force_n),
+            fmt_f64(r.force_n[0]),
+            fmt_f64(r.force_n[1]),
+            fmt_f64(r.delta_t_m[0]),
+            fmt_f64(r.delta_t_m[1]),
+            fmt_f64(r.delta_z_m),
+            fmt_f64(r.contact_area_m2),
+            fmt_f64(r.stick_area_m2),
+            fmt_f64(r.stick_radius_m),
+            fmt_f64(r.dissipated_j),
+            r.segment,
+            r.converged,
+        );
+    }
+    out
+}
+
+/// The loop's lines: (label, [(δt µm, F N)]) along the force direction. The
+/// first loading is its own line; then one line per cycle (two segments).
+fn loop_lines(h: &HistoryOutput) -> Vec<(String, Vec<(f64, f64)>)> {
+    let along = |v: [f64; 2]| v[0] * h.direction[0] + v[1] * h.direction[1];
+    let point = |k: usize| {
+        let r = &h.steps[k];
+        (along(r.delta_t_m) * 1e6, along(r.force_n))
+    };
+    let t = &h.turning_steps;
+    let mut lines = Vec::new();
+    if t.len() < 2 {
+        return lines;
+    }
+    lines.push((
+        "first loading".to_string(),
+        (t[0]..=t[1]).map(point).collect(),
+    ));
+    let mut j = 1;
+    let mut cycle = 1;
+    while j < t.len() - 1 {
+        let end = t[(j + 2).min(t.len() - 1)];
+        lines.push((format!("cycle {cycle}"), (t[j]..=end).map(point).collect()));
+        j += 2;
+        cycle += 1;
+    }
+    lines
+}
+
+/// Draws the hysteresis loop to `path` (PNG or SVG by extension).
+pub fn plot_hysteresis(path: &Path, h: &HistoryOutput, title: &str) -> Result<()> {
+    let lines = loop_lines(h);
+    let size = (760, 520);
+    let is_svg = path.extension().is_some_and(|e| e == "svg");
+    crate::atomic::replace_with(path, |tmp| {
+        if is_svg {
+            draw(
+                SVGBackend::new(tmp, size).into_drawing_area(),
+                &lines,
+                title,
+            )
+        } else {
+            draw(
+                BitMapBackend::new(tmp, size).into_drawing_area(),
+                &lines,
+                title,
+            )
+        }
+    })
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    lines: &[(String, Vec<(f64, f64)>)],
+    title: &str,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+    root.fill(&WHITE).map_err(e)?;
+    let pts = lines.iter().flat_map(|(_, l)| l.iter());
+    let (mut xlo, mut xhi, mut ylo, mut yhi) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in pts {
+        xlo = xlo.min(x);
+        xhi = xhi.max(x);
+        ylo = ylo.min(y);
+        yhi = yhi.max(y);
+    }
+    if !xlo.is_finite() || xhi <= xlo || yhi <= ylo {
+        (xlo, xhi, ylo, yhi) = (-1.0, 1.0, -1.0, 1.0);
+    }
+    let (xp, yp) = ((xhi - xlo) * 0.05, (yhi - ylo) * 0.05);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((xlo - xp)..(xhi + xp), (ylo - yp)..(yhi + yp))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("tangential shift δt along the force (μm)")
+        .y_desc("tangential force F (N)")
+        .draw()
+        .map_err(e)?;
+    const COLOURS: [(u8, u8, u8); 6] = [
+        (0, 0, 0),
+        (31, 119, 180),
+        (214, 39, 40),
+        (44, 160, 44),
+        (255, 127, 14),
+        (148, 103, 189),
+    ];
+    for (k, (label, line)) in lines.iter().enumerate() {
+        let (r, g, b) = COLOURS[k % COLOURS.len()];
+        let colour = RGBColor(r, g, b);
+        chart
+            .draw_series(LineSeries::new(
+                line.iter().copied(),
+                colour.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`.
+/// The table is written first; a picture that cannot be drawn is returned
+/// as a warning, not an error.
+pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
+    std::fs::create_dir_all(dir)?;
+    crate::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
+    let mut warnings = Vec::new();
+    for name in ["hysteresis.png", "hysteresis.svg"] {
+        if let Err(e) = plot_hysteresis(&dir.join(name), h, title) {
+            warnings.push(format!("{name}: {e:#}"));
+        }
+    }
+    Ok(warnings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use solver::HistoryStep;
+
+    fn history() -> HistoryOutput {
+        let steps = (0..=6)
+            .map(|k| HistoryStep {
+                step: k,
+                segment: if k == 0 { 0 } else { (k + 1) / 2 },
+                force_n: [[0.0, 1.0, 2.0, 0.0, -2.0, 0.0, 2.0][k], 0.0],
+                delta_t_m: [[0.0, 1e-6, 3e-6, 1e-6, -3e-6, -1e-6, 3e-6][k], 0.0],
+                converged: true,
+                ..Default::default()
+            })
+            .collect();
+        HistoryOutput {
+            direction: [1.0, 0.0],
+            steps,
+            turning_steps: vec![0, 2, 4, 6],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn history_table_has_a_row_per_step_and_the_issue_columns_first() {
+        let text = history_csv(&history());
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 8);
+        assert!(lines[0].starts_with(
+            "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j"
+        ));
+        assert!(lines[3].starts_with("2,0,2,0,3e-6,0,"), "{}", lines[3]);
+    }
+
+    #[test]
+    fn loop_lines_split_first_loading_and_cycles() {
+        let lines = loop_lines(&history());
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[0].1.len(), 3);
+        // The cycle runs from the first turning point back to the last.
+        assert_eq!(lines[1].1.first(), Some(&(3.0, 2.0)));
+        assert_eq!(lines[1].1.last(), Some(&(3.0, 2.0)));
+        assert_eq!(lines[1].1.len(), 5);
+    }
+}
