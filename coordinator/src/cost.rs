@@ -24,9 +24,21 @@ fn seconds_at_384(spec: &CaseSpec) -> f64 {
 /// on average at 128² against 0.98 s at 384², (384/128)^2.48 = 15.3.
 const CASE_EXPONENT: f64 = 2.5;
 
+/// An increment of a load history costs about 1.5 monotonic solves of the
+/// same case: 1.3× on Table 1(a) Fe at 256² coupled (1.87 s against 1.47 s),
+/// about 1.7× on configs/fretting-sweep.toml's 128² cases.
+const INCREMENT_COST: f64 = 1.5;
+
 /// Expected seconds of one case on one worker.
 pub fn case_seconds(spec: &CaseSpec) -> f64 {
-    seconds_at_384(spec) * (spec.grid.n as f64 / 384.0).powf(CASE_EXPONENT)
+    let one = seconds_at_384(spec) * (spec.grid.n as f64 / 384.0).powf(CASE_EXPONENT);
+    match &spec.history {
+        Some(h) => {
+            let segments = h.turning_points(&spec.load).len().saturating_sub(1);
+            one * INCREMENT_COST * (segments * h.steps_per_segment).max(1) as f64
+        }
+        None => one,
+    }
 }
 
 /// Expected seconds to build one kernel on an `n x n` grid: 0.35 s at 384²

@@ -186,7 +186,7 @@ mod tests {
         let steps = (0..=6)
             .map(|k| HistoryStep {
                 step: k,
-                segment: if k == 0 { 0 } else { (k + 1) / 2 },
+                segment: k.div_ceil(2),
                 force_n: [[0.0, 1.0, 2.0, 0.0, -2.0, 0.0, 2.0][k], 0.0],
                 delta_t_m: [[0.0, 1e-6, 3e-6, 1e-6, -3e-6, -1e-6, 3e-6][k], 0.0],
                 converged: true,

@@ -1075,14 +1075,26 @@ fn issue16_a_fretting_sweep_reports_energy_per_cycle_and_per_case_loops() {
     }
     let case = o.join("fields/Cu/circle-A/045.0");
     let table = read_csv(&case.join("history.csv"));
-    assert_eq!(table.len(), 1 + 1 + 3 * 4, "header, step 0, three segments of 4");
+    assert_eq!(
+        table.len(),
+        1 + 1 + 3 * 4,
+        "header, step 0, three segments of 4"
+    );
     assert!(case.join("hysteresis.png").is_file() && case.join("hysteresis.svg").is_file());
     // The same case in-process.
     let solved = dir.join("solve");
     let out = Command::new(EXE)
         .arg("solve")
         .arg(dir.join("sweep.toml"))
-        .args(["--material", "Cu", "--surface", "circle-A", "--angle-deg", "45", "--out"])
+        .args([
+            "--material",
+            "Cu",
+            "--surface",
+            "circle-A",
+            "--angle-deg",
+            "45",
+            "--out",
+        ])
         .arg(&solved)
         .output()
         .unwrap();
