@@ -148,7 +148,7 @@ impl Solved {
 pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
     let spec = &case.spec;
     crate::memory::check_fits(
-        "this case",
+        &format!("this case ({0} x {0} cells)", spec.grid.n),
         crate::memory::worker_bytes(spec.grid.n, 1),
         1,
         crate::memory::available_bytes(),
