@@ -240,13 +240,15 @@ impl Fft2 {
     /// Forward transform of a full `M x M` real array (used for kernels).
     pub fn forward_full(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.forward_rows(input, self.m, self.m, out);
+        let threads = self.threads.clone();
+        threads.install(|| self.forward_rows(input, self.m, self.m, out));
     }
 
     /// Forward transform of an `N x N` field (row-major, `N` columns) zero-padded to `M x M`.
     pub fn forward_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.forward_rows(input, self.n, self.n, out);
+        let threads = self.threads.clone();
+        threads.install(|| self.forward_rows(input, self.n, self.n, out));
     }
 
     /// Row stage of [`Fft2::forward_padded`]: the row transforms of the `N`
@@ -405,23 +407,32 @@ impl Fft2 {
     /// `N x N` block of the real result, scaled by `1/M²`.
     pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.whole_columns(spec, false);
-        self.inverse_row_stage(spec, self.n, self.n, out, false);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.n, self.n, out, false);
+        });
     }
 
     /// [`Fft2::inverse_cropped`] added to `out` instead of overwriting it.
     pub fn inverse_cropped_add(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.whole_columns(spec, false);
-        self.inverse_row_stage(spec, self.n, self.n, out, true);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.n, self.n, out, true);
+        });
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the full
     /// `M x M` real array, scaled by `1/M²`.
     pub fn inverse_full(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.whole_columns(spec, false);
-        self.inverse_row_stage(spec, self.m, self.m, out, false);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.m, self.m, out, false);
+        });
     }
 
     fn inverse_row_stage(

@@ -423,6 +423,17 @@ impl Operator {
     /// products and inverse transforms while it is in cache, instead of three
     /// passes over the work spectra.
     fn round(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])], add: bool) {
+        let threads = self.fft.threads().clone();
+        threads.install(|| self.round_stages(src, dst, add));
+    }
+
+    /// The stages of [`Operator::round`].
+    fn round_stages(
+        &mut self,
+        src: &[(usize, &[f64])],
+        dst: &mut [(usize, &mut [f64])],
+        add: bool,
+    ) {
         let [w0, w1] = &mut self.work;
         for ((_, t), w) in src.iter().zip([&mut *w0, &mut *w1]) {
             self.fft.forward_rows_padded(t, w);
@@ -461,6 +472,12 @@ impl Operator {
     /// over the padded grid is the sum over the cells). Each column's products
     /// are summed as soon as its transforms are done.
     pub fn tangential_energy(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
+        let threads = self.fft.threads().clone();
+        threads.install(|| self.energy_stages(tx, ty))
+    }
+
+    /// The stages of [`Operator::tangential_energy`].
+    fn energy_stages(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
         let [w0, w1] = &mut self.work;
         self.fft.forward_rows_padded(tx, w0);
         self.fft.forward_rows_padded(ty, w1);

@@ -72,6 +72,17 @@ impl Threads {
         self.pool.as_deref()
     }
 
+    /// Runs `f` on the pool (serial: here). The stages inside `f` then start
+    /// from a pool thread, which hands work to the others without waking
+    /// the caller between stages: one hand-over per operator application
+    /// instead of one per stage.
+    pub(crate) fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        match &self.pool {
+            Some(p) => p.install(f),
+            None => f(),
+        }
+    }
+
     /// Pieces a stage is cut into (each with its own scratch buffers).
     pub(crate) fn tasks(&self) -> usize {
         match self.pool {
