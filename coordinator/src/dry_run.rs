@@ -43,7 +43,7 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     }
     let per_worker = crate::memory::worker_bytes(n, kernels.len());
     crate::memory::check_fits(
-        "the sweep",
+        &format!("the sweep (finest grid {0} x {0} cells)", n),
         per_worker,
         workers,
         crate::memory::available_bytes(),

@@ -97,6 +97,10 @@ enum Cmd {
         /// Override one config key.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
+        /// Threads for this one case (default: all cores); the results are
+        /// the same to the bit for any number.
+        #[arg(long, value_name = "N")]
+        threads: Option<std::num::NonZeroUsize>,
     },
     /// Print the Fourier-domain surface compliance H(θ) of a material as JSON.
     Kernel {
@@ -267,8 +271,10 @@ fn real_main() -> Result<()> {
             angle_deg,
             out,
             sets,
+            threads,
         } => {
             let cfg = Config::load(&config, &sets)?;
+            let threads = threads.map_or_else(solver::Threads::available, |n| n.get());
             let s = coordinator::solve::run_solve(
                 &cfg,
                 &coordinator::solve::SolveArgs {
@@ -276,6 +282,7 @@ fn real_main() -> Result<()> {
                     surface: surface.as_deref(),
                     angle_deg,
                     out: &out,
+                    threads,
                 },
             )?;
             println!(

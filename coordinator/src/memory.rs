@@ -89,4 +89,27 @@ mod tests {
         let at512 = worker_bytes(512, 1);
         assert!((131.2e6..1.5 * 131.2e6).contains(&at512), "{at512}");
     }
+
+    #[test]
+    fn grid_size_is_one_memory_rule_with_the_estimate_in_the_message() {
+        // No fixed cap below what memory allows: 4096² (8.1 GiB) fits a
+        // 24 GiB machine, 8192² (32.5 GiB) does not, and the message says so.
+        let machine = Some(22.1 * GIB);
+        check_fits("this case", worker_bytes(4096, 1), 1, machine).unwrap();
+        let e = check_fits(
+            "this case (8192 x 8192 cells)",
+            worker_bytes(8192, 1),
+            1,
+            machine,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("this case (8192 x 8192 cells) needs about 32.50 GiB")
+                && e.contains("use a coarser grid (grid.points)"),
+            "{e}"
+        );
+        // The solver's own bound is far above any machine's memory.
+        assert!(worker_bytes(solver::MAX_GRID_POINTS, 1) > 100.0 * GIB);
+    }
 }

@@ -54,6 +54,8 @@ pub struct SolveArgs<'a> {
     pub angle_deg: Option<f64>,
     /// Output directory.
     pub out: &'a Path,
+    /// Threads for the case (results do not depend on it).
+    pub threads: usize,
 }
 
 /// One case picked from a config and checked: its names and its spec.
@@ -161,17 +163,19 @@ impl Solved {
     }
 }
 
-/// Solves one case in memory: memory check, the solve, and for an
-/// anisotropic material K_E from its flat twin. Writes nothing.
-pub fn solve_in_memory(case: CaseChoice) -> Result<Solved> {
+/// Solves one case in memory on `threads` threads: memory check, the
+/// solve, and for an anisotropic material K_E from its flat twin. Writes
+/// nothing. The results are the same to the bit for any thread count.
+pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
     let spec = &case.spec;
     crate::memory::check_fits(
-        "this case",
+        &format!("this case ({0} x {0} cells)", spec.grid.n),
         crate::memory::worker_bytes(spec.grid.n, 1),
         1,
         crate::memory::available_bytes(),
     )?;
     let mut cache = worker::kernel_store::FileStore::cache();
+    cache.set_threads(solver::Threads::new(threads).map_err(|e| anyhow!("--threads: {e}"))?);
     let (material, surface, angle) = (&case.material, &case.surface, case.angle_deg);
     let out =
         solve_case(spec, &mut cache).map_err(|e| anyhow!("{material}/{surface}/{angle}°: {e}"))?;
@@ -222,7 +226,7 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
 /// Solves one case of `config` and writes its outputs; returns its scalars.
 pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
-    let solved = solve_in_memory(case)?;
+    let solved = solve_in_memory(case, args.threads)?;
     write_solved(&solved, args.out)?;
     Ok(solved.scalars)
 }

@@ -664,6 +664,7 @@ fn bad_messages_are_rejected_and_logged_and_the_sweep_goes_on() {
                 grid_n: 32,
                 solve_seconds: 0.1,
                 kernel_builds: 1,
+                kernel_loads: 0,
                 kernels_resident: 1,
                 sent_unix_ns: 0,
                 field_names: Vec::new(),

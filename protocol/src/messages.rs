@@ -105,6 +105,10 @@ pub struct ResultHeader<K, R> {
     pub solve_seconds: f64,
     /// Kernels (operators) this worker has built so far in this run.
     pub kernel_builds: u64,
+    /// Of those, how many it loaded from the kernel store (stored by
+    /// another worker or an earlier run) instead of computing them.
+    #[serde(default)]
+    pub kernel_loads: u64,
     /// Distinct (material, grid) kernels resident in this worker.
     pub kernels_resident: u64,
     /// Nanoseconds since the Unix epoch when the result was ready to send

@@ -382,8 +382,10 @@ fn solve<'py>(
         }
     }
     .map_err(value_error)?;
-    let solved = interruptible(py, move || solve_in_memory(case))?
-        .map_err(|e| SolveError::new_err(format!("{e:#}")))?;
+    let solved = interruptible(py, move || {
+        solve_in_memory(case, solver::Threads::available())
+    })?
+    .map_err(|e| SolveError::new_err(format!("{e:#}")))?;
     let value = serde_json::to_value(solved.case_json())
         .map_err(|e| PyRuntimeError::new_err(format!("case.json: {e}")))?;
     let scalars = to_py(py, &value)?;

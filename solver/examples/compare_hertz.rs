@@ -12,7 +12,7 @@ use solver::normal::{NormalOptions, NormalProblem};
 use solver::tangential::{TangentialProblem, TangentialStart};
 use solver::window::contact_window;
 use solver::{build_operator, solve_case, CaseSpec, Grid, KernelCache, Load, Material, Numerics};
-use solver::{Resident, Surface};
+use solver::{Resident, Surface, Threads};
 use std::time::Instant;
 
 const E: f64 = 210.0e9;
@@ -148,7 +148,9 @@ fn hertz(n: usize, args: &Args, res: &mut Resident, options: NormalOptions) {
 }
 
 /// A solve's time divided by the time spent in its own transforms, timed in
-/// place (`fft2::timing`), so the transforms run with the iteration's cache
+/// place (`fft2::timing`; with more than one thread only the transforms run
+/// on the calling thread are counted, so the ratio means something with one
+/// thread only), so the transforms run with the iteration's cache
 /// state rather than hot in a loop of their own. The clock reads of the timed
 /// spans are calibrated with empty spans and taken out of both times.
 fn in_situ_ratio(mut solve: impl FnMut()) -> f64 {
@@ -195,7 +197,7 @@ fn fft_seconds(mut fft: Fft2, field: &[f64], reps: usize) -> (f64, f64) {
     (fwd, inv)
 }
 
-fn slip(n: usize, args: &Args, coupling: bool) {
+fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
     let a = hertz_radius();
     let spec = CaseSpec {
         material: Material::isotropic("Fe", E, NU).expect("valid"),
@@ -219,6 +221,7 @@ fn slip(n: usize, args: &Args, coupling: bool) {
         history: None,
     };
     let mut cache = KernelCache::new();
+    cache.set_threads(threads.clone());
     let _ = cache.resident(&spec).expect("kernel");
     let mut times = Vec::new();
     let mut last = None;
@@ -306,9 +309,17 @@ fn main() {
         }
     };
     let material = Material::isotropic("Fe", E, NU).expect("valid material");
+    let threads = match Threads::new(args.threads) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("compare_hertz: {e}");
+            std::process::exit(2);
+        }
+    };
     for &n in &args.sizes {
         let g = grid(n);
         let mut res = Resident::new(build_operator(&material, g));
+        res.set_threads(&threads);
         for (nested, precondition) in [(true, true), (false, true), (false, false)] {
             let options = NormalOptions {
                 nested,
@@ -318,7 +329,7 @@ fn main() {
         }
     }
     for &n in &args.slip_sizes {
-        slip(n, &args, false);
-        slip(n, &args, true);
+        slip(n, &args, &threads, false);
+        slip(n, &args, &threads, true);
     }
 }

@@ -8,9 +8,12 @@
 //! (zero padding), and inverse transforms only produce the first `N` rows.
 
 use num_complex::Complex64;
+use rayon::prelude::*;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
+
+use crate::parallel::Threads;
 
 /// Time spent in the transforms of this thread, for benchmarks that divide an
 /// iteration's time by the time of the transforms it ran (the "FFT floor" in
@@ -68,7 +71,80 @@ pub mod timing {
 /// one tile: the tile (`TILE x (M/2 + 1)` complex values) stays in cache.
 const TILE: usize = 16;
 
+/// The buffers of one task of a row or column stage.
+struct TaskBufs {
+    row_real: Vec<f64>,
+    /// `TILE` row spectra, `[row][kx]`.
+    tile: Vec<Complex64>,
+    scratch: Vec<Complex64>,
+}
+
+/// A spectrum written by several tasks at once, each at indices no other
+/// task reads or writes (its own rows of the transposed layout).
+#[derive(Clone, Copy)]
+struct Scatter {
+    ptr: *mut Complex64,
+    len: usize,
+}
+
+// SAFETY: a `Scatter` is only shared between tasks that write disjoint
+// index sets of the spectrum it points to (see `row_tiles`), while the
+// `&mut` borrow it was made from is held by the stage that spawned them.
+unsafe impl Send for Scatter {}
+unsafe impl Sync for Scatter {}
+
+impl Scatter {
+    fn new(out: &mut [Complex64]) -> Self {
+        Scatter {
+            ptr: out.as_mut_ptr(),
+            len: out.len(),
+        }
+    }
+
+    /// Writes `v` at `i`.
+    ///
+    /// # Safety
+    /// No other task accesses index `i` during the stage.
+    #[inline]
+    unsafe fn write(self, i: usize, v: Complex64) {
+        assert!(i < self.len);
+        // SAFETY: in bounds (checked above); exclusive by the caller's contract.
+        unsafe { *self.ptr.add(i) = v };
+    }
+}
+
+/// The column transforms with one task's scratch: what work done column by
+/// column (see [`Fft2::column_pass`]) transforms its columns with.
+pub struct Columns<'a> {
+    n: usize,
+    fwd: &'a dyn Fft<f64>,
+    inv: &'a dyn Fft<f64>,
+    scratch: &'a mut [Complex64],
+}
+
+impl Columns<'_> {
+    /// Column `kx` (`M` values) of a spectrum after
+    /// [`Fft2::forward_rows_padded`]: zero padding, then the forward column transform.
+    pub fn forward(&mut self, col: &mut [Complex64]) {
+        let _span = timing::Span::new();
+        col[self.n..].fill(Complex64::default());
+        self.fwd.process_with_scratch(col, self.scratch);
+    }
+
+    /// Inverse column transform of one column (`M` values) of a spectrum;
+    /// [`Fft2::inverse_rows_cropped`] completes the inverse transform.
+    pub fn inverse(&mut self, col: &mut [Complex64]) {
+        let _span = timing::Span::new();
+        self.inv.process_with_scratch(col, self.scratch);
+    }
+}
+
 /// FFT plans and scratch for one padded grid size. Build once, apply many times.
+///
+/// The row and column stages run on the threads set by
+/// [`Fft2::set_threads`] (serial by default): each row or column is one FFT
+/// with the same plan whatever thread runs it, so the results do not depend
+/// on the thread count (see [`crate::parallel`]).
 pub struct Fft2 {
     m: usize,
     n: usize,
@@ -76,10 +152,10 @@ pub struct Fft2 {
     c2r: Arc<dyn ComplexToReal<f64>>,
     col_fwd: Arc<dyn Fft<f64>>,
     col_inv: Arc<dyn Fft<f64>>,
-    row_real: Vec<f64>,
-    /// `TILE` row spectra, `[row][kx]`.
-    tile: Vec<Complex64>,
-    scratch: Vec<Complex64>,
+    threads: Threads,
+    /// One per task ([`Threads`]`::tasks`); the serial stages use the first.
+    tasks: Vec<TaskBufs>,
+    scratch_len: usize,
 }
 
 impl Fft2 {
@@ -105,7 +181,6 @@ impl Fft2 {
         let mut cp = FftPlanner::<f64>::new();
         let col_fwd = cp.plan_fft_forward(m);
         let col_inv = cp.plan_fft_inverse(m);
-        let h = m / 2 + 1;
         let scratch_len = [
             r2c.get_scratch_len(),
             c2r.get_scratch_len(),
@@ -116,17 +191,45 @@ impl Fft2 {
         .max()
         .unwrap_or(0)
         .max(1);
-        Fft2 {
+        let mut fft = Fft2 {
             m,
             n,
             r2c,
             c2r,
             col_fwd,
             col_inv,
-            row_real: vec![0.0; m],
-            tile: vec![Complex64::default(); TILE.min(m) * h],
-            scratch: vec![Complex64::default(); scratch_len],
+            threads: Threads::serial(),
+            tasks: Vec::new(),
+            scratch_len,
+        };
+        fft.tasks.push(fft.task_bufs());
+        fft
+    }
+
+    fn task_bufs(&self) -> TaskBufs {
+        let h = self.m / 2 + 1;
+        TaskBufs {
+            row_real: vec![0.0; self.m],
+            tile: vec![Complex64::default(); TILE.min(self.m) * h],
+            scratch: vec![Complex64::default(); self.scratch_len],
         }
+    }
+
+    /// Runs the stages on `threads` from now on (buffers for its tasks are
+    /// made here, not in the transforms).
+    pub fn set_threads(&mut self, threads: &Threads) {
+        self.threads = threads.clone();
+        let want = threads.tasks();
+        self.tasks.truncate(want);
+        while self.tasks.len() < want {
+            let b = self.task_bufs();
+            self.tasks.push(b);
+        }
+    }
+
+    /// The threads the stages run on.
+    pub fn threads(&self) -> &Threads {
+        &self.threads
     }
 
     /// Number of complex values of a (half) spectrum.
@@ -137,47 +240,87 @@ impl Fft2 {
     /// Forward transform of a full `M x M` real array (used for kernels).
     pub fn forward_full(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.forward_rows(input, self.m, self.m, out);
+        let threads = self.threads.clone();
+        threads.install(|| self.forward_rows(input, self.m, self.m, out));
     }
 
     /// Forward transform of an `N x N` field (row-major, `N` columns) zero-padded to `M x M`.
     pub fn forward_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.forward_rows(input, self.n, self.n, out);
+        let threads = self.threads.clone();
+        threads.install(|| self.forward_rows(input, self.n, self.n, out));
     }
 
     /// Row stage of [`Fft2::forward_padded`]: the row transforms of the `N`
     /// non-zero rows, in place in the transposed spectrum. Entries `N..M` of
-    /// each column are left as they were; [`Fft2::forward_column`] zeroes and
-    /// transforms one column, so a caller can process a column while it is in
-    /// cache (the spectral products between the forward and inverse column
-    /// transforms, see `Operator::apply`).
+    /// each column are left as they were; [`Columns::forward`] (in a
+    /// [`Fft2::column_pass`]) zeroes and transforms one column, so a caller
+    /// can process a column while it is in cache (the spectral products
+    /// between the forward and inverse column transforms, see `Operator::apply`).
     pub fn forward_rows_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
         self.row_stage(input, self.n, self.n, out);
     }
 
-    /// Column `kx` (`M` values, `col`) of a spectrum after
-    /// [`Fft2::forward_rows_padded`]: zero padding, then the forward column transform.
-    pub fn forward_column(&mut self, col: &mut [Complex64]) {
-        let _span = timing::Span::new();
-        debug_assert_eq!(col.len(), self.m);
-        col[self.n..].fill(Complex64::default());
-        self.col_fwd.process_with_scratch(col, &mut self.scratch);
+    /// Calls `f(kx, a_kx, b_kx, columns)` for every column `kx` of two
+    /// spectra `a` and `b` (`M` values each) and stores its value in
+    /// `values[kx]`; the columns are shared out among the threads, each with
+    /// its own [`Columns`]. `b` may be a spectrum `f` does not touch.
+    pub fn column_pass<F>(
+        &mut self,
+        a: &mut [Complex64],
+        b: &mut [Complex64],
+        values: &mut [f64],
+        f: F,
+    ) where
+        F: Fn(usize, &mut [Complex64], &mut [Complex64], &mut Columns<'_>) -> f64 + Sync,
+    {
+        let m = self.m;
+        let h = m / 2 + 1;
+        debug_assert_eq!(a.len(), m * h);
+        debug_assert_eq!(b.len(), m * h);
+        debug_assert_eq!(values.len(), h);
+        let (n, fwd, inv) = (self.n, &*self.col_fwd, &*self.col_inv);
+        let Some(pool) = self.threads.pool() else {
+            let mut cols = Columns {
+                n,
+                fwd,
+                inv,
+                scratch: &mut self.tasks[0].scratch,
+            };
+            let pairs = a.chunks_exact_mut(m).zip(b.chunks_exact_mut(m));
+            for (kx, ((ca, cb), v)) in pairs.zip(values.iter_mut()).enumerate() {
+                *v = f(kx, ca, cb, &mut cols);
+            }
+            return;
+        };
+        let per = h.div_ceil(self.tasks.len());
+        let parts = a
+            .par_chunks_mut(per * m)
+            .zip(b.par_chunks_mut(per * m))
+            .zip(values.par_chunks_mut(per))
+            .zip(self.tasks.par_iter_mut())
+            .enumerate();
+        pool.install(|| {
+            parts.for_each(|(t, (((a, b), vals), bufs))| {
+                let mut cols = Columns {
+                    n,
+                    fwd,
+                    inv,
+                    scratch: &mut bufs.scratch,
+                };
+                let pairs = a.chunks_exact_mut(m).zip(b.chunks_exact_mut(m));
+                for (k, ((ca, cb), v)) in pairs.zip(vals.iter_mut()).enumerate() {
+                    *v = f(t * per + k, ca, cb, &mut cols);
+                }
+            })
+        });
     }
 
-    /// Inverse column transform of column `col` (`M` values) of a spectrum;
-    /// [`Fft2::inverse_rows_cropped`] completes the inverse transform.
-    pub fn inverse_column(&mut self, col: &mut [Complex64]) {
-        let _span = timing::Span::new();
-        debug_assert_eq!(col.len(), self.m);
-        self.col_inv.process_with_scratch(col, &mut self.scratch);
-    }
-
-    /// Row stage of [`Fft2::inverse_cropped`] (`add`: of
+    /// Inverse row stage of [`Fft2::inverse_cropped`] (`add`: of
     /// [`Fft2::inverse_cropped_add`]) on a spectrum whose columns have been
-    /// through [`Fft2::inverse_column`].
-    pub fn inverse_rows_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64], add: bool) {
+    /// through [`Columns::inverse`].
+    pub fn inverse_rows_cropped(&mut self, spec: &[Complex64], out: &mut [f64], add: bool) {
         let _span = timing::Span::new();
         self.inverse_row_stage(spec, self.n, self.n, out, add);
     }
@@ -190,34 +333,47 @@ impl Fft2 {
         for kx in 0..h {
             out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
         }
-        self.col_fwd.process_with_scratch(out, &mut self.scratch);
+        self.whole_columns(out, true);
+    }
+
+    /// The column transforms (forward or inverse) of a whole spectrum.
+    fn whole_columns(&mut self, spec: &mut [Complex64], forward: bool) {
+        let plan = if forward {
+            &self.col_fwd
+        } else {
+            &self.col_inv
+        };
+        let Some(pool) = self.threads.pool() else {
+            plan.process_with_scratch(spec, &mut self.tasks[0].scratch);
+            return;
+        };
+        let m = self.m;
+        let per = (m / 2 + 1).div_ceil(self.tasks.len());
+        let parts = spec.par_chunks_mut(per * m).zip(self.tasks.par_iter_mut());
+        pool.install(|| {
+            parts.for_each(|(s, bufs)| plan.process_with_scratch(s, &mut bufs.scratch))
+        });
     }
 
     fn row_stage(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
         let m = self.m;
-        let h = m / 2 + 1;
         debug_assert_eq!(input.len(), nrows * ncols);
-        debug_assert_eq!(out.len(), m * h);
-        // Row transforms of the non-zero rows, a tile at a time, each tile
-        // moved into its place in the transposed spectrum ([kx][ky]).
-        for iy0 in (0..nrows).step_by(TILE) {
-            let iy1 = (iy0 + TILE).min(nrows);
-            for (r, iy) in (iy0..iy1).enumerate() {
-                self.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
-                self.row_real[ncols..].fill(0.0);
-                let dst = &mut self.tile[r * h..(r + 1) * h];
-                // Lengths are fixed by construction, so this cannot fail.
-                let _ = self
-                    .r2c
-                    .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
-            }
-            for kx in 0..h {
-                let col = &mut out[kx * m + iy0..kx * m + iy1];
-                for (r, c) in col.iter_mut().enumerate() {
-                    *c = self.tile[r * h + kx];
-                }
-            }
-        }
+        debug_assert_eq!(out.len(), m * (m / 2 + 1));
+        let r2c = &*self.r2c;
+        let out = Scatter::new(out);
+        let Some(pool) = self.threads.pool() else {
+            row_tiles(r2c, &mut self.tasks[0], input, ncols, 0..nrows, m, out);
+            return;
+        };
+        // Whole tiles per task, so the tasks' rows are disjoint.
+        let per = nrows.div_ceil(TILE).div_ceil(self.tasks.len()) * TILE;
+        let parts = self.tasks.par_iter_mut().enumerate();
+        pool.install(|| {
+            parts.for_each(|(t, bufs)| {
+                let rows = (t * per).min(nrows)..((t + 1) * per).min(nrows);
+                row_tiles(r2c, bufs, input, ncols, rows, m, out);
+            })
+        });
     }
 
     /// Row stage of a forward transform of a full `M x M` real array supplied
@@ -229,12 +385,13 @@ impl Fft2 {
         let h = m / 2 + 1;
         debug_assert_eq!(row.len(), m);
         debug_assert_eq!(out.len(), m * h);
-        self.row_real.copy_from_slice(row);
-        let dst = &mut self.tile[..h];
+        let bufs = &mut self.tasks[0];
+        bufs.row_real.copy_from_slice(row);
+        let dst = &mut bufs.tile[..h];
         // Lengths are fixed by construction, so this cannot fail.
         let _ = self
             .r2c
-            .process_with_scratch(&mut self.row_real, dst, &mut self.scratch);
+            .process_with_scratch(&mut bufs.row_real, dst, &mut bufs.scratch);
         for (kx, v) in dst.iter().enumerate() {
             out[kx * m + iy] = *v;
         }
@@ -243,77 +400,144 @@ impl Fft2 {
     /// Column stage completing the rows given to [`Fft2::forward_row_into`].
     pub fn forward_columns(&mut self, out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.col_fwd.process_with_scratch(out, &mut self.scratch);
+        self.whole_columns(out, true);
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the first
     /// `N x N` block of the real result, scaled by `1/M²`.
     pub fn inverse_cropped(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.inverse_columns(spec);
-        self.inverse_row_stage(spec, self.n, self.n, out, false);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.n, self.n, out, false);
+        });
     }
 
     /// [`Fft2::inverse_cropped`] added to `out` instead of overwriting it.
     pub fn inverse_cropped_add(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.inverse_columns(spec);
-        self.inverse_row_stage(spec, self.n, self.n, out, true);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.n, self.n, out, true);
+        });
     }
 
     /// Inverse transform of a spectrum (consumed as scratch) into the full
     /// `M x M` real array, scaled by `1/M²`.
     pub fn inverse_full(&mut self, spec: &mut [Complex64], out: &mut [f64]) {
         let _span = timing::Span::new();
-        self.inverse_columns(spec);
-        self.inverse_row_stage(spec, self.m, self.m, out, false);
-    }
-
-    /// Inverse column transforms of a whole spectrum.
-    fn inverse_columns(&mut self, spec: &mut [Complex64]) {
-        self.col_inv.process_with_scratch(spec, &mut self.scratch);
+        let threads = self.threads.clone();
+        threads.install(|| {
+            self.whole_columns(spec, false);
+            self.inverse_row_stage(spec, self.m, self.m, out, false);
+        });
     }
 
     fn inverse_row_stage(
         &mut self,
-        spec: &mut [Complex64],
+        spec: &[Complex64],
         n: usize,
         ncols: usize,
         out: &mut [f64],
         add: bool,
     ) {
         let m = self.m;
-        let h = m / 2 + 1;
-        debug_assert_eq!(spec.len(), m * h);
+        debug_assert_eq!(spec.len(), m * (m / 2 + 1));
         debug_assert_eq!(out.len(), n * ncols);
-        let scale = 1.0 / (m as f64 * m as f64);
-        // The first n rows, a tile at a time: gather from the transposed
-        // spectrum, then inverse row transforms.
-        for iy0 in (0..n).step_by(TILE) {
-            let iy1 = (iy0 + TILE).min(n);
-            for kx in 0..h {
-                let col = &spec[kx * m + iy0..kx * m + iy1];
-                for (r, c) in col.iter().enumerate() {
-                    self.tile[r * h + kx] = *c;
-                }
-            }
+        let c2r = &*self.c2r;
+        let Some(pool) = self.threads.pool() else {
+            inverse_tiles(c2r, &mut self.tasks[0], spec, 0, ncols, m, out, add);
+            return;
+        };
+        // Whole tiles per task: each task owns its rows of `out`.
+        let per = n.div_ceil(TILE).div_ceil(self.tasks.len()) * TILE;
+        let parts = out
+            .par_chunks_mut(per * ncols)
+            .zip(self.tasks.par_iter_mut())
+            .enumerate();
+        pool.install(|| {
+            parts.for_each(|(t, (rows, bufs))| {
+                inverse_tiles(c2r, bufs, spec, t * per, ncols, m, rows, add);
+            })
+        });
+    }
+}
+
+/// Row transforms of rows `rows` of `input` (`ncols` values each, zero
+/// padded to `M`), a tile at a time, each tile moved into its place in the
+/// transposed spectrum `out` (`[kx][ky]`). Writes only `out[kx * M + iy]` for
+/// `iy` in `rows`.
+fn row_tiles(
+    r2c: &dyn RealToComplex<f64>,
+    bufs: &mut TaskBufs,
+    input: &[f64],
+    ncols: usize,
+    rows: std::ops::Range<usize>,
+    m: usize,
+    out: Scatter,
+) {
+    let h = m / 2 + 1;
+    for iy0 in rows.clone().step_by(TILE) {
+        let iy1 = (iy0 + TILE).min(rows.end);
+        for (r, iy) in (iy0..iy1).enumerate() {
+            bufs.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
+            bufs.row_real[ncols..].fill(0.0);
+            let dst = &mut bufs.tile[r * h..(r + 1) * h];
+            // Lengths are fixed by construction, so this cannot fail.
+            let _ = r2c.process_with_scratch(&mut bufs.row_real, dst, &mut bufs.scratch);
+        }
+        for kx in 0..h {
             for (r, iy) in (iy0..iy1).enumerate() {
-                let dst = &mut self.tile[r * h..(r + 1) * h];
-                // The imaginary parts of the DC and Nyquist bins are zero up to
-                // round-off; realfft would reject them, so clear them explicitly.
-                dst[0].im = 0.0;
-                dst[h - 1].im = 0.0;
-                let _ = self
-                    .c2r
-                    .process_with_scratch(dst, &mut self.row_real, &mut self.scratch);
-                let row = out[iy * ncols..(iy + 1) * ncols]
-                    .iter_mut()
-                    .zip(&self.row_real[..ncols]);
-                if add {
-                    row.for_each(|(o, v)| *o += v * scale);
-                } else {
-                    row.for_each(|(o, v)| *o = v * scale);
-                }
+                // SAFETY: row `iy` belongs to this task's `rows` only.
+                unsafe { out.write(kx * m + iy, bufs.tile[r * h + kx]) };
+            }
+        }
+    }
+}
+
+/// Inverse row transforms of the rows `first..` of a transposed spectrum
+/// whose columns are done, into `out` (those rows, `ncols` values each,
+/// scaled by `1/M²`, added when `add`), a tile at a time.
+#[allow(clippy::too_many_arguments)]
+fn inverse_tiles(
+    c2r: &dyn ComplexToReal<f64>,
+    bufs: &mut TaskBufs,
+    spec: &[Complex64],
+    first: usize,
+    ncols: usize,
+    m: usize,
+    out: &mut [f64],
+    add: bool,
+) {
+    let h = m / 2 + 1;
+    let scale = 1.0 / (m as f64 * m as f64);
+    let nrows = out.len() / ncols;
+    // Gather a tile from the transposed spectrum, then inverse row transforms.
+    for r0 in (0..nrows).step_by(TILE) {
+        let r1 = (r0 + TILE).min(nrows);
+        let (iy0, iy1) = (first + r0, first + r1);
+        for kx in 0..h {
+            let col = &spec[kx * m + iy0..kx * m + iy1];
+            for (r, c) in col.iter().enumerate() {
+                bufs.tile[r * h + kx] = *c;
+            }
+        }
+        for r in 0..r1 - r0 {
+            let dst = &mut bufs.tile[r * h..(r + 1) * h];
+            // The imaginary parts of the DC and Nyquist bins are zero up to
+            // round-off; realfft would reject them, so clear them explicitly.
+            dst[0].im = 0.0;
+            dst[h - 1].im = 0.0;
+            let _ = c2r.process_with_scratch(dst, &mut bufs.row_real, &mut bufs.scratch);
+            let row = out[(r0 + r) * ncols..(r0 + r + 1) * ncols]
+                .iter_mut()
+                .zip(&bufs.row_real[..ncols]);
+            if add {
+                row.for_each(|(o, v)| *o += v * scale);
+            } else {
+                row.for_each(|(o, v)| *o = v * scale);
             }
         }
     }

@@ -11,6 +11,7 @@ use crate::grid::Grid;
 use crate::material::Material;
 use crate::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
 use crate::operator::{Operator, Spectra};
+use crate::parallel::Threads;
 use crate::spec::CaseSpec;
 use crate::tangential::{solve_tangential, TangentialProblem, TangentialSolution};
 use crate::window::WindowCache;
@@ -54,7 +55,29 @@ pub trait KernelStore {
     fn load(&self, key: &KernelKey, len: usize) -> Option<Spectra>;
     /// Stores the spectra under `key` (best effort).
     fn save(&self, key: &KernelKey, spectra: &Spectra);
+    /// Tries to take the right to build `key` (so that processes sharing the
+    /// store build each kernel once): [`BuildLock::Held`] until the guard is
+    /// dropped, [`BuildLock::Busy`] while another holder builds it. The lock
+    /// must end with its holder, also when the holder dies (e.g. `flock`).
+    /// The default: no locking.
+    fn try_lock(&self, _key: &KernelKey) -> BuildLock {
+        BuildLock::Unsupported
+    }
 }
+
+/// What [`KernelStore::try_lock`] found.
+pub enum BuildLock {
+    /// Ours until this guard is dropped.
+    Held(Box<dyn std::any::Any>),
+    /// Someone else holds it: wait, then look in the store again.
+    Busy,
+    /// The store does not lock (or cannot now): build without.
+    Unsupported,
+}
+
+/// How often a process waiting for another's kernel build looks again
+/// (the build it waits for takes seconds; 0.6 s for a 384² Cu(111) kernel).
+const LOCK_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
 /// The operator of a material on a grid, built row by row (see [`Operator::build`]).
 pub fn build_operator(material: &Material, grid: Grid) -> Operator {
@@ -84,6 +107,16 @@ impl Resident {
     }
 
     /// [`solve_normal`] on this bundle.
+    /// Runs this kernel's transforms on `threads` (a window operator made
+    /// for other threads is dropped and made again when next needed).
+    pub fn set_threads(&mut self, threads: &Threads) {
+        if !self.operator.threads().same(threads) {
+            self.operator.set_threads(threads);
+            self.normal.set_threads(threads);
+            self.windows.clear();
+        }
+    }
+
     pub fn solve_normal(&mut self, prob: &NormalProblem) -> Result<NormalSolution, SolverError> {
         solve_normal(&mut self.operator, &mut self.normal, prob)
     }
@@ -104,6 +137,7 @@ pub struct KernelCache {
     builds: usize,
     loads: usize,
     store: Option<Box<dyn KernelStore>>,
+    threads: Threads,
 }
 
 impl KernelCache {
@@ -131,6 +165,15 @@ impl KernelCache {
         self.loads
     }
 
+    /// Solves of this cache's kernels run on `threads` from now on (serial
+    /// by default); the results do not depend on it (see [`Threads`]).
+    pub fn set_threads(&mut self, threads: Threads) {
+        for r in self.resident.values_mut() {
+            r.set_threads(&threads);
+        }
+        self.threads = threads;
+    }
+
     /// The bundle for `spec`, built (or loaded) on first use; the second
     /// value is the time that took (0 when it was already resident).
     pub fn resident(&mut self, spec: &CaseSpec) -> Result<(&mut Resident, f64), SolverError> {
@@ -141,11 +184,37 @@ impl KernelCache {
             let grid = spec.grid;
             let len = Spectra::len_for(grid.n);
             let persistent = spec.material.model().persist_tables();
-            let stored = match (&self.store, persistent) {
-                (Some(store), true) => store.load(&key, len),
-                _ => None,
+            let load = |store: &dyn KernelStore| {
+                store
+                    .load(&key, len)
+                    .and_then(|s| Operator::from_spectra(grid, s))
             };
-            let op = match stored.and_then(|s| Operator::from_spectra(grid, s)) {
+            let mut loaded = None;
+            // Held while this process builds the kernel, so that others
+            // sharing the store wait for it and load it instead.
+            let mut _guard = None;
+            if let (Some(store), true) = (&self.store, persistent) {
+                loaded = load(store.as_ref());
+                while loaded.is_none() {
+                    match store.try_lock(&key) {
+                        BuildLock::Held(g) => {
+                            // Built by the previous holder while we waited?
+                            loaded = load(store.as_ref());
+                            _guard = Some(g);
+                            break;
+                        }
+                        BuildLock::Busy => {
+                            // A waiting worker still shows it is alive, and
+                            // a cancel still stops it.
+                            crate::progress::tick_or_cancel()?;
+                            std::thread::sleep(LOCK_POLL);
+                            loaded = load(store.as_ref());
+                        }
+                        BuildLock::Unsupported => break,
+                    }
+                }
+            }
+            let op = match loaded {
                 Some(op) => {
                     self.loads += 1;
                     op
@@ -159,6 +228,9 @@ impl KernelCache {
                     op
                 }
             };
+            drop(_guard);
+            let mut op = op;
+            op.set_threads(&self.threads);
             let bundle = Resident::new(op);
             took = start.elapsed().as_secs_f64();
             self.resident.insert(key.clone(), bundle);

@@ -53,6 +53,7 @@ mod material;
 pub mod multilevel;
 pub mod normal;
 pub mod operator;
+mod parallel;
 pub mod presets;
 mod progress;
 mod results;
@@ -65,9 +66,10 @@ pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
 pub use history::{HistoryOutput, HistoryStep, DISSIPATION_DEFINITION};
-pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
+pub use kernels::{build_operator, BuildLock, KernelCache, KernelKey, KernelStore, Resident};
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
+pub use parallel::Threads;
 pub use progress::{cancel, set_tick_hook, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,

@@ -13,6 +13,7 @@
 
 use crate::fft2::Fft2;
 use crate::grid::Grid;
+use crate::parallel::Threads;
 use num_complex::Complex64;
 
 /// Fourier preconditioner of the normal iteration: `z = Π W Π g` with `W` the
@@ -54,6 +55,11 @@ impl FourierPrecond {
             spec,
             field: vec![0.0; n * n],
         }
+    }
+
+    /// Runs the transforms on `threads` (results unchanged, see [`Threads`]).
+    pub fn set_threads(&mut self, threads: &Threads) {
+        self.fft.set_threads(threads);
     }
 
     /// `z = Π W Π g` over the cells where `active` is true (`z` is zero elsewhere).
@@ -110,6 +116,12 @@ impl CoarseLevel {
             *s *= k;
         }
         self.fft.inverse_cropped(&mut self.spec, uz);
+    }
+
+    /// Runs this level's transforms on `threads` (results unchanged).
+    pub fn set_threads(&mut self, threads: &Threads) {
+        self.fft.set_threads(threads);
+        self.precond.set_threads(threads);
     }
 
     /// The Fourier preconditioner of this level.

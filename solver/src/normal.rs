@@ -8,6 +8,7 @@
 use crate::error::SolverError;
 use crate::multilevel::{coarse_levels, prolong, restrict, CoarseLevel, FourierPrecond};
 use crate::operator::Operator;
+use crate::parallel::Threads;
 
 /// Convergence report of one normal solve.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -62,9 +63,13 @@ impl ZzApply for Fine<'_> {
         self.op.normal(p, uz);
     }
     fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
-        let grid = self.op.grid();
+        let (grid, threads) = (self.op.grid(), self.op.threads());
         self.precond
-            .get_or_insert_with(|| FourierPrecond::new(grid))
+            .get_or_insert_with(|| {
+                let mut pre = FourierPrecond::new(grid);
+                pre.set_threads(threads);
+                pre
+            })
             .apply(g, active, z);
     }
 }
@@ -91,9 +96,22 @@ impl NormalCache {
     /// (held only while they are made).
     pub fn new(op: &mut Operator) -> Self {
         let table = op.zz_table();
-        NormalCache {
+        let mut cache = NormalCache {
             coarse: coarse_levels(op.grid(), &table),
             precond: None,
+        };
+        cache.set_threads(op.threads());
+        cache
+    }
+
+    /// Runs the coarse levels' and the preconditioner's transforms on
+    /// `threads` (results unchanged, see [`crate::Threads`]).
+    pub fn set_threads(&mut self, threads: &Threads) {
+        for level in &mut self.coarse {
+            level.set_threads(threads);
+        }
+        if let Some(pre) = &mut self.precond {
+            pre.set_threads(threads);
         }
     }
 

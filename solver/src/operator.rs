@@ -8,6 +8,7 @@
 use crate::fft2::Fft2;
 pub use crate::grid::Grid;
 use crate::influence::Block;
+use crate::parallel::Threads;
 use num_complex::Complex64;
 
 /// Displacement / traction component index: x, y (tangential) and z (normal).
@@ -196,6 +197,8 @@ pub struct Operator {
     /// Two work spectra: the sources of an apply round, overwritten in place
     /// by the destinations' spectra.
     work: [Vec<Complex64>; 2],
+    /// One value per column of a column pass (the energy product's terms).
+    column_values: Vec<f64>,
     tangential_bound: f64,
 }
 
@@ -309,9 +312,10 @@ impl Operator {
         Operator {
             grid,
             tangential_bound: tangential_symbol_max(&spectra),
-            fft,
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
+            column_values: vec![0.0; fft.padded_len() / 2 + 1],
+            fft,
         }
     }
 
@@ -344,6 +348,7 @@ impl Operator {
         let m = self.fft.padded_len();
         let mw = 2 * nw;
         let mut fft = Fft2::new(nw);
+        fft.set_threads(self.fft.threads());
         // One component at a time: its real-space table on this grid (an
         // inverse transform of the stored spectrum), the window's offsets
         // (row and column `nw` zero, as in a build) into the window's spectrum.
@@ -372,6 +377,18 @@ impl Operator {
         }
         drop((spec, table));
         Self::with_fft(grid, fft, Spectra::from_stored(out))
+    }
+
+    /// Runs the transforms and spectral products on `threads` from now on
+    /// (the results do not change, see [`crate::parallel`]); window
+    /// operators made later inherit them.
+    pub fn set_threads(&mut self, threads: &Threads) {
+        self.fft.set_threads(threads);
+    }
+
+    /// The threads this operator runs on.
+    pub fn threads(&self) -> &Threads {
+        self.fft.threads()
     }
 
     /// The kernel spectra held (what a kernel store persists).
@@ -406,6 +423,17 @@ impl Operator {
     /// products and inverse transforms while it is in cache, instead of three
     /// passes over the work spectra.
     fn round(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])], add: bool) {
+        let threads = self.fft.threads().clone();
+        threads.install(|| self.round_stages(src, dst, add));
+    }
+
+    /// The stages of [`Operator::round`].
+    fn round_stages(
+        &mut self,
+        src: &[(usize, &[f64])],
+        dst: &mut [(usize, &mut [f64])],
+        add: bool,
+    ) {
         let [w0, w1] = &mut self.work;
         for ((_, t), w) in src.iter().zip([&mut *w0, &mut *w1]) {
             self.fft.forward_rows_padded(t, w);
@@ -418,19 +446,21 @@ impl Operator {
         }
         let m = self.fft.padded_len();
         let (ns, nd) = (src.len(), dst.len());
-        for r in (0..m / 2 + 1).map(|kx| kx * m..(kx + 1) * m) {
-            let (c0, c1) = (&mut w0[r.clone()], &mut w1[r.clone()]);
-            self.fft.forward_column(c0);
-            if ns > 1 {
-                self.fft.forward_column(c1);
-            }
-            let kc = k.map(|row| row.map(|kr| kr.part(r.clone())));
-            mix(&kc, ns, nd, c0, c1);
-            self.fft.inverse_column(c0);
-            if nd > 1 {
-                self.fft.inverse_column(c1);
-            }
-        }
+        self.fft
+            .column_pass(w0, w1, &mut self.column_values, |kx, c0, c1, cols| {
+                cols.forward(c0);
+                if ns > 1 {
+                    cols.forward(c1);
+                }
+                let r = kx * m..(kx + 1) * m;
+                let kc = k.map(|row| row.map(|kr| kr.part(r.clone())));
+                mix(&kc, ns, nd, c0, c1);
+                cols.inverse(c0);
+                if nd > 1 {
+                    cols.inverse(c1);
+                }
+                0.0
+            });
         for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
             self.fft.inverse_rows_cropped(w, u, add);
         }
@@ -442,6 +472,12 @@ impl Operator {
     /// over the padded grid is the sum over the cells). Each column's products
     /// are summed as soon as its transforms are done.
     pub fn tangential_energy(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
+        let threads = self.fft.threads().clone();
+        threads.install(|| self.energy_stages(tx, ty))
+    }
+
+    /// The stages of [`Operator::tangential_energy`].
+    fn energy_stages(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
         let [w0, w1] = &mut self.work;
         self.fft.forward_rows_padded(tx, w0);
         self.fft.forward_rows_padded(ty, w1);
@@ -451,14 +487,19 @@ impl Operator {
             &self.spectra.diag[Y],
             &self.spectra.off[0],
         );
+        // Each column's term on the threads, their sum in column order here.
+        self.fft
+            .column_pass(w0, w1, &mut self.column_values, |kx, c0, c1, cols| {
+                let col = kx * m..(kx + 1) * m;
+                cols.forward(c0);
+                cols.forward(c1);
+                // A half spectrum: columns 0 < kx < M/2 stand for their mirror too.
+                let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
+                weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col])
+            });
         let mut sum = 0.0;
-        for (kx, col) in (0..m / 2 + 1).map(|kx| (kx, kx * m..(kx + 1) * m)) {
-            let (c0, c1) = (&mut w0[col.clone()], &mut w1[col.clone()]);
-            self.fft.forward_column(c0);
-            self.fft.forward_column(c1);
-            // A half spectrum: columns 0 < kx < M/2 stand for their mirror too.
-            let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
-            sum += weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col]);
+        for v in &self.column_values {
+            sum += v;
         }
         sum / (m as f64 * m as f64)
     }

@@ -9,8 +9,12 @@ use crate::material::Material;
 use crate::surface::Surface;
 use serde::{Deserialize, Serialize};
 
-/// Largest grid accepted (cells per side): 4096² needs ~10 GiB of kernel spectra.
-pub const MAX_GRID_POINTS: usize = 4096;
+/// Largest grid accepted (cells per side): a bound on index arithmetic and
+/// transform sizes only, far above what a machine holds (16384² needs about
+/// 130 GiB). Whether a grid fits is one rule of the front end: the estimated
+/// memory of the case against what the machine has available
+/// (`coordinator::memory`, with the estimate in its message).
+pub const MAX_GRID_POINTS: usize = 16384;
 
 /// The sphere and what is applied to it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -11,9 +11,17 @@
 //! warning) and is rebuilt and rewritten. A directory that another user can
 //! write to (group- or world-writable, or owned by someone else) is refused:
 //! its kernels could be replaced under us.
+//!
+//! Each kernel is built once for all the processes sharing the directory: a
+//! process about to build one takes an exclusive `flock` on `<entry>.lock`
+//! beside the entry, and the others wait for the entry instead of building it
+//! too. The kernel releases the lock when its holder exits or dies, so a
+//! crashed builder leaves no stale lock: the next waiter takes it, finds no
+//! entry and builds. Lock files are left in place (removing one while
+//! another process opens it would let two builders in).
 
 use num_complex::Complex64;
-use solver::{KernelKey, KernelStore, Spectra};
+use solver::{BuildLock, KernelKey, KernelStore, Spectra};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -179,6 +187,35 @@ impl FileStore {
         self.dir.join(format!("{h:016x}.kern"))
     }
 
+    /// Takes the build lock of `key` without waiting (see the module docs).
+    fn lock(&self, key: &KernelKey) -> BuildLock {
+        use std::os::fd::AsRawFd;
+        use std::os::unix::fs::OpenOptionsExt;
+        let path = self.path(key).with_extension("lock");
+        let file = match std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .mode(0o600)
+            .open(&path)
+        {
+            Ok(f) => f,
+            Err(_) => return BuildLock::Unsupported,
+        };
+        // SAFETY: flock on a descriptor we own; it has no memory effects.
+        let rc = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+        if rc == 0 {
+            // Held as long as the file stays open.
+            return BuildLock::Held(Box::new(file));
+        }
+        match std::io::Error::last_os_error().raw_os_error() {
+            Some(libc::EWOULDBLOCK) | Some(libc::EINTR) => BuildLock::Busy,
+            // A file system without flock: build without the lock.
+            _ => BuildLock::Unsupported,
+        }
+    }
+
     fn read(path: &Path, key: &KernelKey, len: usize) -> std::io::Result<Entry> {
         let key = key.as_str();
         let file = std::io::BufReader::new(std::fs::File::open(path)?);
@@ -326,6 +363,13 @@ impl KernelStore for FileStore {
         }
     }
 
+    fn try_lock(&self, key: &KernelKey) -> BuildLock {
+        if !self.usable() {
+            return BuildLock::Unsupported;
+        }
+        self.lock(key)
+    }
+
     fn save(&self, key: &KernelKey, spectra: &Spectra) {
         if !self.usable() {
             return;
@@ -382,12 +426,7 @@ mod tests {
             "bit-identical pressure from the stored kernel"
         );
         // A corrupted file is ignored and rebuilt.
-        let file = std::fs::read_dir(&dir)
-            .unwrap()
-            .next()
-            .unwrap()
-            .unwrap()
-            .path();
+        let file = only_file(&dir);
         let bytes = std::fs::read(&file).unwrap();
         std::fs::write(&file, &bytes[..bytes.len() / 2]).unwrap();
         let mut third = solver::KernelCache::with_store(Box::new(FileStore::new(dir.clone())));
@@ -407,10 +446,12 @@ mod tests {
         solver::KernelCache::with_store(Box::new(FileStore::new(dir.to_path_buf())))
     }
 
+    /// The one entry in `dir` (lock files aside).
     fn only_file(dir: &Path) -> PathBuf {
         let files: Vec<PathBuf> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "kern"))
             .collect();
         assert_eq!(files.len(), 1, "{files:?}");
         files[0].clone()
@@ -501,5 +542,62 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(left.len(), 1, "temporary files left: {left:?}");
+    }
+
+    /// Kernels built (not loaded) by a cache.
+    fn built(cache: &solver::KernelCache) -> usize {
+        cache.builds() - cache.loads()
+    }
+
+    #[test]
+    fn two_caches_racing_on_a_cold_store_build_the_kernel_once() {
+        // Two workers of a sweep needing the same anisotropic kernel at once.
+        for _ in 0..3 {
+            let (_tmp, dir) = private_store();
+            let start = std::sync::Barrier::new(2);
+            let counts: Vec<(usize, usize)> = std::thread::scope(|s| {
+                let racers: Vec<_> = (0..2)
+                    .map(|_| {
+                        s.spawn(|| {
+                            let mut cache = cache_in(&dir);
+                            start.wait();
+                            cache.resident(&spec()).unwrap();
+                            (built(&cache), cache.loads())
+                        })
+                    })
+                    .collect();
+                racers.into_iter().map(|r| r.join().unwrap()).collect()
+            });
+            let builds: usize = counts.iter().map(|c| c.0).sum();
+            let loads: usize = counts.iter().map(|c| c.1).sum();
+            assert_eq!((builds, loads), (1, 1), "{counts:?}");
+        }
+    }
+
+    #[test]
+    fn a_waiter_builds_the_kernel_itself_when_the_builder_dies_without_storing_it() {
+        // The lock is a flock: it ends when its holder's descriptor closes,
+        // which is what the kernel does when a process exits or is killed.
+        let (_tmp, dir) = private_store();
+        let holder = FileStore::new(dir.clone());
+        let BuildLock::Held(guard) = holder.try_lock(&KernelKey::of(&spec())) else {
+            panic!("a cold store's lock is free");
+        };
+        let waiter = std::thread::spawn({
+            let dir = dir.clone();
+            move || {
+                let mut cache = cache_in(&dir);
+                cache.resident(&spec()).unwrap();
+                (built(&cache), cache.loads())
+            }
+        });
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        assert!(
+            !waiter.is_finished(),
+            "the waiter waits while the lock is held"
+        );
+        drop(guard);
+        assert_eq!(waiter.join().unwrap(), (1, 0), "built by the waiter");
+        assert!(only_file(&dir).exists());
     }
 }

@@ -183,6 +183,7 @@ fn solve_one<K: WireKey>(
                 grid_n: case.grid_n,
                 solve_seconds,
                 kernel_builds: cache.builds() as u64,
+                kernel_loads: cache.loads() as u64,
                 kernels_resident: keys.len() as u64,
                 sent_unix_ns: 0,
                 field_names: if want {

@@ -261,6 +261,9 @@ impl<'a> Dispatch<'a> {
                 field_bytes,
             )?;
         }
+        if let Some(peer) = self.peers.get_mut(&worker) {
+            peer.stats.kernel_loads = peer.stats.kernel_loads.max(h.kernel_loads);
+        }
         let outcome = Outcome {
             status: Status::of_solved(h.scalars.0.converged),
             error: None,

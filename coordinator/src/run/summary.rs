@@ -18,6 +18,9 @@ pub struct WorkerSummary {
     pub cases: u64,
     /// Kernels (operators) it built — once per (material, grid) it saw.
     pub kernel_builds: u64,
+    /// Of those, how many it loaded from the kernel store (built by another
+    /// worker, which it waited for, or by an earlier run) instead of computing.
+    pub kernel_loads: u64,
     /// It died (or was lost) during the run.
     pub died: bool,
 }
