@@ -36,6 +36,7 @@
 
 pub mod aniso;
 mod case;
+pub mod coarse_slip;
 mod coupling;
 mod error;
 #[doc(hidden)]
