@@ -51,6 +51,7 @@ impl TangentialLevels {
                 let mut t = op.table(i, j);
                 let mut n = grid.n;
                 for (level, g) in tables.iter_mut().zip(&grids) {
+                    crate::progress::tick();
                     t = coarse_table(&t, n);
                     level[c] = t.clone();
                     n = g.n;
