@@ -156,10 +156,8 @@ mod tests {
                 }
             }
         }
-        // Measured 7.7e-14: the corner sums cancel (large terms, small
-        // result) far from the cell, so either evaluation carries this round-off.
         assert!(
-            worst < 1e-12,
+            worst < 1e-14,
             "mirrored vs direct evaluation: {worst:e} of K_zz(0)"
         );
     }

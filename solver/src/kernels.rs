@@ -92,8 +92,8 @@ pub fn build_mirrored(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Operator 
     let mut quad = vec![[[0.0; 3]; 3]; n];
     let mut row = vec![0.0; m];
     for oy in 0..=n {
+        crate::progress::tick();
         if oy == n {
-            crate::progress::tick();
             // The row separating positive from negative offsets is zero.
             row.fill(0.0);
             for out in full.iter_mut() {
@@ -108,8 +108,6 @@ pub fn build_mirrored(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Operator 
             .into_iter()
             .chain((oy > 0).then_some((m - oy, true)));
         for (iy, neg_y) in rows {
-            // One tick per row of the wrap-around grid, as in the direct build.
-            crate::progress::tick();
             for (&(i, j), out) in STORED.iter().zip(full.iter_mut()) {
                 let (s, sx) = (
                     mirror_sign(i, j, false, neg_y),
