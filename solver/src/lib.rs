@@ -63,7 +63,7 @@ pub mod window;
 pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
-pub use kernels::{build_mirrored, build_operator, KernelCache, KernelKey, KernelStore, Resident};
+pub use kernels::{build_operator, KernelCache, KernelKey, KernelStore, Resident};
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
 pub use progress::{cancel, set_tick_hook, TickHook};
