@@ -37,6 +37,7 @@
 
 pub mod aniso;
 mod case;
+pub mod coarse_slip;
 mod coupling;
 mod error;
 #[doc(hidden)]

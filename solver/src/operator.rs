@@ -331,6 +331,41 @@ impl Operator {
         table
     }
 
+    /// The real table of component `(i, j)` on the `2N x 2N` wrap-around grid
+    /// (layout of [`Operator::tables`]), by one inverse transform of its
+    /// stored spectrum: what Galerkin coarse levels are made from.
+    pub fn table(&mut self, i: usize, j: usize) -> Vec<f64> {
+        let mut spec = vec![Complex64::default(); self.fft.spectrum_len()];
+        self.spectra.component(i, j).write_complex(&mut spec);
+        let m = self.fft.padded_len();
+        let mut table = vec![0.0; m * m];
+        self.fft.inverse_full(&mut spec, &mut table);
+        table
+    }
+
+    /// An operator of the tangential block only, from the real tables of
+    /// `K_xx`, `K_yy` and `K_xy` (layout of [`Operator::tables`]): what the
+    /// tangential solver's coarse levels need. The normal and coupling
+    /// components are left empty (no memory): only
+    /// [`Operator::tangential`], [`Operator::tangential_add`] and
+    /// [`Operator::tangential_energy`] may be used on it.
+    pub fn tangential_from_tables(grid: Grid, xx: &[f64], yy: &[f64], xy: &[f64]) -> Self {
+        let mut fft = Fft2::new(grid.n);
+        let slen = fft.spectrum_len();
+        let mut spec = |t: &[f64]| {
+            let mut s = vec![Complex64::default(); slen];
+            fft.forward_full(t, &mut s);
+            s
+        };
+        let re = |s: Vec<Complex64>| s.iter().map(|z| z.re).collect::<Vec<f64>>();
+        let (sxx, syy, sxy) = (re(spec(xx)), re(spec(yy)), spec(xy));
+        let spectra = Spectra {
+            diag: [sxx, syy, Vec::new()],
+            off: [sxy, Vec::new(), Vec::new()],
+        };
+        Self::with_fft(grid, fft, spectra)
+    }
+
     /// The operator of an `nw x nw` window of this grid (same cells, `nw ≤ N`):
     /// the same influence coefficients for offsets below `nw` cells, on the
     /// smaller `2nw x 2nw` wrap-around grid, taken from this operator's

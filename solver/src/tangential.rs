@@ -9,6 +9,7 @@
 //! multiplier λ (found by Newton's method) before clipping them to their discs;
 //! λ divided by the step is the rigid shift δt of the sphere.
 
+use crate::coarse_slip::{coarse_start, TangentialLevels};
 use crate::error::SolverError;
 use crate::operator::Operator;
 use crate::window::{contact_window, WindowCache};
@@ -38,6 +39,10 @@ pub struct TangentialReport {
     /// conjugate-gradient step lengths.
     #[serde(default)]
     pub energy_products: usize,
+    /// Iterations on the coarse levels of a coarse-to-fine start (each costs
+    /// a quarter, a sixteenth, … of a fine one); not part of `iterations`.
+    #[serde(default)]
+    pub coarse_iterations: usize,
 }
 
 /// Solution of a tangential problem.
@@ -237,7 +242,8 @@ pub fn solve_tangential(
 ) -> Result<TangentialSolution, SolverError> {
     let n = op.grid().n;
     let Some(win) = contact_window(n, prob.p) else {
-        return solve_tangential_on_grid(op, prob);
+        let levels = windows.grid_levels(op);
+        return solve_nested(op, levels, prob);
     };
     let p = win.gather(prob.p);
     let extra = prob.extra.map(|(ex, ey)| (win.gather(ex), win.gather(ey)));
@@ -254,7 +260,8 @@ pub fn solve_tangential(
         },
         ..*prob
     };
-    let sol = solve_tangential_on_grid(windows.operator(op, win.n), &sub)?;
+    let (wop, levels) = windows.operator_and_levels(op, win.n);
+    let sol = solve_nested(wop, levels, &sub)?;
     Ok(TangentialSolution {
         qx: win.scatter(&sol.qx, 0.0),
         qy: win.scatter(&sol.qy, 0.0),
@@ -265,8 +272,35 @@ pub fn solve_tangential(
     })
 }
 
-/// [`solve_tangential`] on the whole grid, without a contact window (for
-/// comparisons and tests).
+/// [`solve_tangential_on_grid`] with a coarse-to-fine start when the problem
+/// starts from rest ([`TangentialStart::Proportional`]): the problem is solved
+/// on `levels` (coarsest first), and the prolonged coarse tractions start the
+/// fine iteration, which runs to the same tolerance and KKT test as without
+/// them. A start given by the caller is kept as it is.
+pub fn solve_nested(
+    op: &mut Operator,
+    levels: &mut TangentialLevels,
+    prob: &TangentialProblem,
+) -> Result<TangentialSolution, SolverError> {
+    if !matches!(prob.start, TangentialStart::Proportional) {
+        return solve_tangential_on_grid(op, prob);
+    }
+    let Some((qx, qy, coarse)) = coarse_start(levels, prob)? else {
+        return solve_tangential_on_grid(op, prob);
+    };
+    let mut sol = solve_tangential_on_grid(
+        op,
+        &TangentialProblem {
+            start: TangentialStart::Tractions(&qx, &qy),
+            ..*prob
+        },
+    )?;
+    sol.report.coarse_iterations = coarse;
+    Ok(sol)
+}
+
+/// [`solve_tangential`] on the whole grid, without a contact window or a
+/// coarse-to-fine start (for comparisons and tests).
 pub fn solve_tangential_on_grid(
     op: &mut Operator,
     prob: &TangentialProblem,

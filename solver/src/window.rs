@@ -4,6 +4,7 @@
 //! Knows the grid's cells and the operator's window construction; no contact
 //! conditions.
 
+use crate::coarse_slip::TangentialLevels;
 use crate::operator::Operator;
 
 /// A square `n x n` window of an `N x N` grid, its first cell at column `x0`, row `y0`.
@@ -93,10 +94,14 @@ pub fn contact_window(n: usize, p: &[f64]) -> Option<Window> {
 }
 
 /// The window operator the tangential solver keeps for one operator: the
-/// last window size asked for. A window of another size replaces it.
+/// last window size asked for. A window of another size replaces it. With it,
+/// the coarse tangential levels of that window and of the whole grid (the
+/// coarse-to-fine start), made on first use.
 #[derive(Default)]
 pub struct WindowCache {
     window: Option<Box<Operator>>,
+    window_levels: Option<TangentialLevels>,
+    grid_levels: Option<TangentialLevels>,
 }
 
 impl WindowCache {
@@ -106,14 +111,41 @@ impl WindowCache {
         if self.window.as_ref().map(|w| w.grid().n) != Some(nw) {
             // Free the old window before building the new one (lower peak).
             self.window = None;
+            self.window_levels = None;
             self.window = Some(Box::new(op.window_operator(nw)));
         }
         self.window.as_mut().expect("set above")
     }
 
-    /// Frees the window operator kept, if any.
+    /// The window operator of [`WindowCache::operator`] and its coarse
+    /// tangential levels (made on first use).
+    pub fn operator_and_levels(
+        &mut self,
+        op: &mut Operator,
+        nw: usize,
+    ) -> (&mut Operator, &mut TangentialLevels) {
+        self.operator(op, nw);
+        let w = self.window.as_mut().expect("set above");
+        let levels = self
+            .window_levels
+            .get_or_insert_with(|| TangentialLevels::new(w));
+        (w, levels)
+    }
+
+    /// The coarse tangential levels of `op`'s whole grid (made on first use).
+    pub fn grid_levels(&mut self, op: &mut Operator) -> &mut TangentialLevels {
+        if self.grid_levels.as_ref().map(|l| l.fine_n()) != Some(op.grid().n) {
+            self.grid_levels = None;
+            self.grid_levels = Some(TangentialLevels::new(op));
+        }
+        self.grid_levels.as_mut().expect("set above")
+    }
+
+    /// Frees the window operator and the coarse levels kept, if any.
     pub fn clear(&mut self) {
         self.window = None;
+        self.window_levels = None;
+        self.grid_levels = None;
     }
 
     /// The side of the window operator kept, if any.

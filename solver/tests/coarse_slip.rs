@@ -1,0 +1,128 @@
+//! The coarse-to-fine start of the tangential solver changes the path, not
+//! the answer: on Cattaneo–Mindlin (Table 1a, coupling off) the nested solve
+//! and the plain fine solve, both to the same KKT tolerance 1e-6, give the
+//! same stick set, shifts within the tolerance (measured 1e-10 relative) and
+//! tractions within 100x it relative to μ p_max (measured 1.3e-5 and 1.6e-5:
+//! two solutions whose slip residuals are below 1e-6 |δt| differ in traction
+//! by the residual times the inverse compliance, about 10x here).
+
+use solver::coarse_slip::TangentialLevels;
+use solver::influence::isotropic_cell;
+use solver::normal::{solve_normal, NormalCache, NormalProblem};
+use solver::operator::{Grid, Operator};
+use solver::tangential::{
+    solve_nested, solve_tangential, solve_tangential_on_grid, TangentialProblem,
+    TangentialSolution, TangentialStart,
+};
+use solver::window::WindowCache;
+
+const MU: f64 = 0.28571;
+const LOAD: f64 = 20.0;
+const TOL: f64 = 1e-6;
+
+/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm: the Hertz pressure on
+/// an `n x n` grid of cell `d`, and the operator.
+fn hertz(n: usize, d: f64) -> (Operator, Vec<f64>) {
+    let grid = Grid { n, dx: d, dy: d };
+    let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
+    let g = e / (2.0 * (1.0 + nu));
+    let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
+    let h: Vec<f64> = (0..grid.len())
+        .map(|i| {
+            let (x, y) = (grid.x(i % n), grid.y(i / n));
+            (x * x + y * y) / (2.0 * r)
+        })
+        .collect();
+    let mut cache = NormalCache::new(&mut op);
+    let p = solve_normal(&mut op, &mut cache, &NormalProblem::new(&h, LOAD))
+        .unwrap()
+        .p;
+    (op, p)
+}
+
+fn problem(p: &[f64]) -> TangentialProblem<'_> {
+    TangentialProblem {
+        p,
+        friction: MU,
+        force: [0.6 * MU * LOAD, 0.0],
+        extra: None,
+        tolerance: TOL,
+        max_iterations: 5000,
+        start: TangentialStart::Proportional,
+    }
+}
+
+/// max |Δq| / (μ p_max), |Δδt| / |δt| and the number of cells whose stick
+/// state differs.
+fn compare(a: &TangentialSolution, b: &TangentialSolution, p: &[f64]) -> (f64, f64, usize) {
+    let pmax = p.iter().cloned().fold(0.0, f64::max);
+    let dq = (0..p.len())
+        .map(|i| (a.qx[i] - b.qx[i]).hypot(a.qy[i] - b.qy[i]))
+        .fold(0.0, f64::max)
+        / (MU * pmax);
+    let dt =
+        (a.shift[0] - b.shift[0]).hypot(a.shift[1] - b.shift[1]) / a.shift[0].hypot(a.shift[1]);
+    let stick = (0..p.len()).filter(|&i| a.stick[i] != b.stick[i]).count();
+    (dq, dt, stick)
+}
+
+#[test]
+fn nested_start_reaches_the_plain_fine_solution_on_the_whole_grid() {
+    // Domain 2.4 a: the contact spans more than 80 % of the side, no window.
+    let (mut op, p) = hertz(128, 2.0e-6);
+    let mut levels = TangentialLevels::new(&mut op);
+    assert_eq!(levels.len(), 2, "64² and 32²");
+    let plain = solve_tangential_on_grid(&mut op, &problem(&p)).unwrap();
+    let nested = solve_nested(&mut op, &mut levels, &problem(&p)).unwrap();
+    let (dq, dt, stick) = compare(&plain, &nested, &p);
+    println!(
+        "plain {} it, nested {} fine + {} coarse it: max|Δq|/μp_max {dq:.2e}, Δδt/δt {dt:.2e}, stick cells differing {stick}",
+        plain.report.iterations, nested.report.iterations, nested.report.coarse_iterations
+    );
+    assert!(plain.report.converged && nested.report.converged);
+    assert!(plain.report.change < TOL && nested.report.change < TOL);
+    assert!(nested.report.coarse_iterations > 0, "the coarse levels ran");
+    assert!(dq < 100.0 * TOL, "tractions differ by {dq:e} of μ p_max");
+    assert!(dt < TOL, "shifts differ by {dt:e}");
+    assert_eq!(stick, 0, "stick sets differ");
+    assert!(nested.report.force_error < 1e-10);
+}
+
+#[test]
+fn nested_start_through_the_contact_window_reaches_the_plain_solution() {
+    // Domain 4.5 a: the solve runs on a window and its own coarse levels.
+    let (mut op, p) = hertz(128, 3.7e-6);
+    let mut windows = WindowCache::default();
+    let nested = solve_tangential(&mut op, &mut windows, &problem(&p)).unwrap();
+    assert!(windows.side().is_some_and(|s| s < 128), "a window was used");
+    let plain = solve_tangential_on_grid(&mut op, &problem(&p)).unwrap();
+    let (dq, dt, stick) = compare(&plain, &nested, &p);
+    println!(
+        "plain {} it, nested {} fine + {} coarse it: max|Δq|/μp_max {dq:.2e}, Δδt/δt {dt:.2e}, stick cells differing {stick}",
+        plain.report.iterations, nested.report.iterations, nested.report.coarse_iterations
+    );
+    assert!(plain.report.converged && nested.report.converged);
+    assert!(nested.report.coarse_iterations > 0, "the coarse levels ran");
+    assert!(dq < 100.0 * TOL, "tractions differ by {dq:e} of μ p_max");
+    assert!(dt < TOL, "shifts differ by {dt:e}");
+    assert_eq!(stick, 0, "stick sets differ");
+}
+
+/// A caller's start (a load history's previous increment) is kept: the
+/// solve equals the plain one to the bit.
+#[test]
+fn a_given_start_is_not_replaced() {
+    let (mut op, p) = hertz(64, 4.0e-6);
+    let mut levels = TangentialLevels::new(&mut op);
+    let first = solve_tangential_on_grid(&mut op, &problem(&p)).unwrap();
+    let warm = TangentialProblem {
+        start: TangentialStart::Tractions(&first.qx, &first.qy),
+        force: [0.5 * MU * LOAD, 0.1 * MU * LOAD],
+        ..problem(&p)
+    };
+    let plain = solve_tangential_on_grid(&mut op, &warm).unwrap();
+    let nested = solve_nested(&mut op, &mut levels, &warm).unwrap();
+    assert_eq!(plain.qx, nested.qx);
+    assert_eq!(plain.qy, nested.qy);
+    assert_eq!(nested.report.coarse_iterations, 0);
+}
