@@ -139,11 +139,23 @@ fn hertz(n: usize, args: &Args, res: &mut Resident, options: NormalOptions) {
         let pc = if options.precondition { periodic } else { 0.0 };
         let fft_s = (pair * apps + pc * its) / its;
         println!(
-            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"normal iteration, {mode}\", \"n\": {n}, \"threads\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {in_situ:.3}, \"ok\": true}}",
+            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"normal iteration, {mode}\", \"n\": {n}, \"threads\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {}, \"ok\": true}}",
             args.threads,
             apps / its,
-            iter_s / fft_s
+            iter_s / fft_s,
+            json_ratio(in_situ)
         );
+    }
+}
+
+/// A ratio as JSON: `null` when it is not finite (with more than one thread
+/// the in-place transform timing sees only the calling thread's share, and
+/// was printed as `inf`, which is not JSON).
+fn json_ratio(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3}")
+    } else {
+        "null".into()
     }
 }
 
@@ -272,13 +284,14 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
         let iter_s = median(ts) / its;
         let fft_s = (2.0 * pair * apps + 2.0 * fwd * rep.energy_products as f64) / its;
         println!(
-            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"tangential CG iteration (Cattaneo-Mindlin)\", \"n\": {n}, \"window\": {nw}, \"threads\": {}, \"iterations\": {}, \"cg_iterations\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"energy_products_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {in_situ:.3}, \"ok\": true}}",
+            "{{\"solver\": \"mpcontact\", \"kind\": \"fft_floor\", \"what\": \"tangential CG iteration (Cattaneo-Mindlin)\", \"n\": {n}, \"window\": {nw}, \"threads\": {}, \"iterations\": {}, \"cg_iterations\": {}, \"iter_seconds\": {iter_s:.6}, \"fft_seconds\": {fft_s:.6}, \"applications_per_iteration\": {:.3}, \"energy_products_per_iteration\": {:.3}, \"fft_pair_seconds\": {pair:.6}, \"ratio\": {:.3}, \"in_situ_ratio\": {}, \"ok\": true}}",
             args.threads,
             rep.iterations,
             rep.cg_iterations,
             apps / its,
             rep.energy_products as f64 / its,
-            iter_s / fft_s
+            iter_s / fft_s,
+            json_ratio(in_situ)
         );
     }
     let s = &out.scalars;
