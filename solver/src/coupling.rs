@@ -244,11 +244,7 @@ pub(crate) fn solve_step(
                     tol.max(1e-2 * prev_change),
                 )
             };
-            let tan_tol = if step.tolerance_scale > 1.0 {
-                tan_tol * step.tolerance_scale
-            } else {
-                tan_tol
-            };
+            let tan_tol = tan_tol * step.tolerance_scale;
             if num.coupling {
                 // hq is free until uz(q) is computed below.
                 for ((d, a), b) in hq.iter_mut().zip(&p).zip(&p0) {

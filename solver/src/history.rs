@@ -155,8 +155,11 @@ pub(crate) fn solve_history(
     let (mut delta_t_max, mut last_increment) = (0.0_f64, 0.0_f64);
     let mut normal_iterations = last.normal_iterations;
     let (mut tangential_iterations, mut coupling_iterations) = (0, 0);
+    // The surface's heights (for the stick radius of every row), once.
+    let heights = spec.surface.heights(&grid);
     let mut rows = vec![row(
         spec,
+        &heights,
         &last,
         &StepSums {
             step: 0,
@@ -281,6 +284,7 @@ pub(crate) fn solve_history(
             coupling_iterations += state.coupling_iterations;
             let r = row(
                 spec,
+                &heights,
                 &state,
                 &StepSums {
                     step: step_no,
@@ -323,7 +327,7 @@ struct StepSums {
 }
 
 /// The table row of a solved increment.
-fn row(spec: &CaseSpec, state: &ContactState, sums: &StepSums) -> HistoryStep {
+fn row(spec: &CaseSpec, heights: &[f64], state: &ContactState, sums: &StepSums) -> HistoryStep {
     let grid = spec.grid;
     let (len, da) = (grid.len(), grid.cell_area());
     let p = &state.p;
@@ -335,9 +339,8 @@ fn row(spec: &CaseSpec, state: &ContactState, sums: &StepSums) -> HistoryStep {
     let reserve: Vec<f64> = (0..len)
         .map(|i| (mu * p[i] - tan.qx[i].hypot(tan.qy[i])).max(0.0))
         .collect();
-    let heights = spec.surface.heights(&grid);
     let stick_radius = if stick.iter().any(|&b| b) {
-        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, &heights))
+        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights))
     } else {
         0.0
     };

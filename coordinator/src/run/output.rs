@@ -192,29 +192,18 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
         else {
             continue;
         };
-        let hs = solved.iter().map(|&(h, _)| h);
-        let (Some(mu_a), Some(k_e)) = (
-            estimate(
-                &hs.clone()
-                    .zip(mu_a_by_level.iter().copied())
-                    .collect::<Vec<_>>(),
-            ),
-            estimate(
-                &hs.zip(solved.iter().map(|(_, s)| s.k_e))
-                    .collect::<Vec<_>>(),
-            ),
-        ) else {
+        // The estimate over the levels of one scalar (None if a level lacks it).
+        let over_levels = |value: &dyn Fn(&CaseScalars) -> Option<f64>| {
+            let pairs: Option<Vec<(f64, f64)>> =
+                solved.iter().map(|&(h, s)| Some((h, value(s)?))).collect();
+            estimate(&pairs?)
+        };
+        let (Some(mu_a), Some(k_e)) = (over_levels(&|s| s.mu_a), over_levels(&|s| Some(s.k_e)))
+        else {
             continue;
         };
         let (_, finest) = solved[solved.len() - 1];
-        let dissipated = solved
-            .iter()
-            .map(|&(h, s)| {
-                let e = s.history.as_ref()?.dissipated_energy_per_cycle_j?;
-                Some((h, e))
-            })
-            .collect::<Option<Vec<_>>>()
-            .and_then(|v| estimate(&v));
+        let dissipated = over_levels(&|s| s.history.as_ref()?.dissipated_energy_per_cycle_j);
         points.push(CurvePoint {
             key,
             mu_a,
