@@ -25,6 +25,12 @@ pub trait ElasticModel {
     /// True when building its tables is expensive enough to persist them
     /// (numerical Green's functions), false for closed forms.
     fn persist_tables(&self) -> bool;
+    /// True when its cell influence is exactly (to the bit) even or odd in x
+    /// and in y with the parities of [`crate::influence::mirror_sign`], so
+    /// that a kernel build may evaluate one quadrant and mirror it.
+    fn mirror_symmetric(&self) -> bool {
+        false
+    }
     /// Stiffness in the surface frame (Pa, Voigt).
     fn stiffness(&self) -> Matrix6<f64>;
     /// Checks the constants; errors name the parameter (`youngs`, `poisson`, `stiffness`).
@@ -90,6 +96,9 @@ impl ElasticModel for Isotropic {
     }
     fn persist_tables(&self) -> bool {
         false
+    }
+    fn mirror_symmetric(&self) -> bool {
+        true
     }
     fn stiffness(&self) -> Matrix6<f64> {
         Isotropic::stiffness(self)

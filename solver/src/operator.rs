@@ -262,6 +262,66 @@ impl Operator {
         Self::with_fft(grid, fft, Spectra::from_stored(full))
     }
 
+    /// [`Operator::build`] for a cell influence that is exactly even or odd in x
+    /// and y with the parities of [`crate::influence::mirror_sign`]: `cell` is evaluated only at
+    /// offsets `x, y ≥ 0` (the `N x N` quadrant of the `2N x 2N` wrap-around
+    /// grid, a quarter of the `(2N − 1)²` evaluations of the direct build), and
+    /// each quadrant row gives the rows of `+y` and `−y`, mirrored in x with the
+    /// components' signs. The rows handed to the transforms are those of the
+    /// direct build, to the bit, so the spectra are too (tested). Isotropic
+    /// closed forms at 2048²: 12 s in the direct build, dominated by the
+    /// `ln`/`atan` of the corner sums.
+    pub fn build_mirrored(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Self {
+        let n = grid.n;
+        let m = 2 * n;
+        let mut fft = Fft2::new(n);
+        let slen = fft.spectrum_len();
+        let mut full: Vec<Vec<Complex64>> = (0..STORED.len())
+            .map(|_| vec![Complex64::default(); slen])
+            .collect();
+        let mut quad = vec![[[0.0; 3]; 3]; n];
+        let mut row = vec![0.0; m];
+        for oy in 0..=n {
+            if oy == n {
+                crate::progress::tick();
+                // The row separating positive from negative offsets is zero.
+                row.fill(0.0);
+                for out in full.iter_mut() {
+                    fft.forward_row_into(n, &row, out);
+                }
+                continue;
+            }
+            for (ox, b) in quad.iter_mut().enumerate() {
+                *b = cell(ox as f64 * grid.dx, oy as f64 * grid.dy);
+            }
+            let rows = [(oy, false)]
+                .into_iter()
+                .chain((oy > 0).then_some((m - oy, true)));
+            for (iy, neg_y) in rows {
+                // One tick per row of the wrap-around grid, as in the direct build.
+                crate::progress::tick();
+                for (&(i, j), out) in STORED.iter().zip(full.iter_mut()) {
+                    let (s, sx) = (
+                        crate::influence::mirror_sign(i, j, false, neg_y),
+                        crate::influence::mirror_sign(i, j, true, neg_y),
+                    );
+                    for (ix, r) in row.iter_mut().enumerate() {
+                        *r = match ix.cmp(&n) {
+                            std::cmp::Ordering::Less => s * quad[ix][i][j],
+                            std::cmp::Ordering::Equal => 0.0,
+                            std::cmp::Ordering::Greater => sx * quad[m - ix][i][j],
+                        };
+                    }
+                    fft.forward_row_into(iy, &row, out);
+                }
+            }
+        }
+        for s in full.iter_mut() {
+            fft.forward_columns(s);
+        }
+        Self::with_fft(grid, fft, Spectra::from_stored(full))
+    }
+
     /// The nine real-space kernels on the `2N x 2N` wrap-around grid
     /// (`tables[3 i + j]`, row-major), for tests and inspection.
     pub fn tables(grid: Grid, cell: impl Fn(f64, f64) -> Block) -> Vec<Vec<f64>> {
