@@ -15,7 +15,14 @@
 #   OURS=...             command for mpcontact's side (default: the compare_hertz
 #                        example, built here); gets --sizes --reps --threads
 #   PEER_TOL_PRESET=matched|nominal   peers' tolerances (see hertz_peers.py)
-#   PEER_TIMEOUT=SECONDS  per peer mode × size in the Hertz runs (default none)
+#   PEER_TIMEOUT=SECONDS  per peer mode × size in the Hertz runs (default none);
+#                        a mode that exceeds it is not run at the larger sizes
+#   REPS_ONE_FROM=N      sizes from N on are solved once (ours and the peers)
+#   HEADLINE_FROM=N      sizes from N on run only the fastest mode of each solver
+#                        (ours: nested + preconditioned; aspher: nested-fft-precond)
+# Round 2 of the performance work (docs/performance.md) ran
+#   SIZES=256,512,1024,2048,4096 REPS_ONE_FROM=1024 HEADLINE_FROM=2048 \
+#   PEER_TIMEOUT=120 SKIP_SWEEP=1 bench/compare.sh
 # Peers are installed in bench/.venv (created if missing; aspher builds from
 # source, about 4 minutes, and needs Debian's libeigen3-dev).
 # Rough cost with the defaults: peers ~25 min (contactmechanics and tamaas take
@@ -31,6 +38,9 @@ SKIP_SWEEP=${SKIP_SWEEP:-0}
 SKIP_PEERS=${SKIP_PEERS:-0}
 PEER_TOL_PRESET=${PEER_TOL_PRESET:-matched}
 PEER_TIMEOUT=${PEER_TIMEOUT:-}
+REPS_ONE_FROM=${REPS_ONE_FROM:-}
+HEADLINE_FROM=${HEADLINE_FROM:-}
+SIZE_ARGS=(${REPS_ONE_FROM:+--reps-one-from "$REPS_ONE_FROM"} ${HEADLINE_FROM:+--headline-from "$HEADLINE_FROM"})
 VENV=bench/.venv
 PY=$VENV/bin/python
 JSONL=$OUT/compare.jsonl
@@ -126,10 +136,11 @@ PY
 for T in 1 2; do
   (
     export OMP_NUM_THREADS=$T OPENBLAS_NUM_THREADS=$T MKL_NUM_THREADS=$T
-    run_json mpcontact "$T" "${OURS_CMD[@]}" --sizes "$SIZES" --reps "$REPS" --threads "$T"
+    run_json mpcontact "$T" "${OURS_CMD[@]}" --sizes "$SIZES" --reps "$REPS" --threads "$T" "${SIZE_ARGS[@]}"
     if [ "$SKIP_PEERS" != 1 ]; then
       run_json hertz-peers "$T" "$PY" bench/peers/hertz_peers.py --peers tamaas,contactmechanics,aspher \
-        --sizes "$SIZES" --reps "$REPS" --tol-preset "$PEER_TOL_PRESET" ${PEER_TIMEOUT:+--timeout "$PEER_TIMEOUT"}
+        --sizes "$SIZES" --reps "$REPS" --tol-preset "$PEER_TOL_PRESET" ${PEER_TIMEOUT:+--timeout "$PEER_TIMEOUT"} \
+        "${SIZE_ARGS[@]}"
       run_json slip-peers "$T" "$PY" bench/peers/slip_peers.py --peers aspher,tamaas
     fi
   )

@@ -218,7 +218,11 @@ def main():
     ap.add_argument("--tol-preset", choices=sorted(TOL_PRESETS), default="matched")
     ap.add_argument("--tol", action="append", default=[], metavar="PEER=VALUE", help="override a peer's tolerance")
     ap.add_argument("--check", action="store_true", help="also measure the pressure error vs a converged reference")
-    ap.add_argument("--timeout", type=float, default=None, help="seconds allowed per peer mode × size (all reps)")
+    ap.add_argument("--timeout", type=float, default=None,
+                    help="seconds allowed per peer mode × size (all reps); a mode that exceeds it is not run at larger sizes")
+    ap.add_argument("--reps-one-from", type=int, default=None, help="sizes from this one on are solved once")
+    ap.add_argument("--headline-from", type=int, default=None,
+                    help="sizes from this one on run only each peer's fastest mode (aspher: nested-fft-precond)")
     args = ap.parse_args()
 
     tols = dict(TOL_PRESETS[args.tol_preset])
@@ -250,12 +254,21 @@ def main():
         for mode in MODES[peer]:
             if only and mode not in only:
                 continue
+            too_slow = None
             for n in sizes:
+                if args.headline_from and n >= args.headline_from and mode != MODES[peer][-1]:
+                    continue
+                reps = 1 if args.reps_one_from and n >= args.reps_one_from else args.reps
                 base = {"solver": peer, "mode": mode, "kind": "hertz", "n": n, "threads": thr,
-                        "tol": tols[peer], "tol_preset": args.tol_preset, "reps": args.reps}
-                res, e = pb.run_isolated(job, (peer, mode, n, tols[peer], args.reps, refs.get(n)), timeout=args.timeout)
+                        "tol": tols[peer], "tol_preset": args.tol_preset, "reps": reps}
+                if too_slow:
+                    pb.emit({**base, "ok": False, "error": f"not run: exceeded the time budget at {too_slow}²"})
+                    continue
+                res, e = pb.run_isolated(job, (peer, mode, n, tols[peer], reps, refs.get(n)), timeout=args.timeout)
                 if e:
                     pb.emit({**base, "ok": False, "error": e})
+                    if "time budget" in e:
+                        too_slow = n
                 else:
                     pb.emit({**base, **res, "ok": True})
 

@@ -6,6 +6,8 @@
 //! from the solve times, which are medians of `--reps` runs.
 //!
 //! `cargo run --release -p mpcontact-solver --example compare_hertz -- --sizes 256,512 --reps 3`
+//! (`--reps-one-from N`: sizes from N on are solved once; `--headline-from N`:
+//! sizes from N on run only the nested + preconditioned mode.)
 
 use solver::fft2::{timing, Fft2};
 use solver::normal::{NormalOptions, NormalProblem};
@@ -39,6 +41,21 @@ struct Args {
     slip_sizes: Vec<usize>,
     reps: usize,
     threads: usize,
+    /// Sizes from this one on are solved once (`--reps-one-from`).
+    reps_one_from: usize,
+    /// Sizes from this one on run only the headline mode, nested +
+    /// preconditioned (`--headline-from`): plain PK takes ~4 min at 4096².
+    headline_from: usize,
+}
+
+impl Args {
+    fn reps(&self, n: usize) -> usize {
+        if n >= self.reps_one_from {
+            1
+        } else {
+            self.reps
+        }
+    }
 }
 
 fn parse() -> Result<Args, String> {
@@ -47,6 +64,8 @@ fn parse() -> Result<Args, String> {
         slip_sizes: vec![128, 256, 512],
         reps: 3,
         threads: 1,
+        reps_one_from: usize::MAX,
+        headline_from: usize::MAX,
     };
     let list = |v: &str| -> Result<Vec<usize>, String> {
         v.split(',')
@@ -62,6 +81,12 @@ fn parse() -> Result<Args, String> {
             "--slip-sizes" => a.slip_sizes = list(&v)?,
             "--reps" => a.reps = v.parse().map_err(|e| format!("--reps: {e}"))?,
             "--threads" => a.threads = v.parse().map_err(|e| format!("--threads: {e}"))?,
+            "--reps-one-from" => {
+                a.reps_one_from = v.parse().map_err(|e| format!("--reps-one-from: {e}"))?
+            }
+            "--headline-from" => {
+                a.headline_from = v.parse().map_err(|e| format!("--headline-from: {e}"))?
+            }
             other => return Err(format!("unknown option {other}")),
         }
     }
@@ -98,7 +123,7 @@ fn hertz(n: usize, args: &Args, res: &mut Resident, options: NormalOptions) {
     };
     let mut times = Vec::new();
     let mut last = None;
-    for _ in 0..args.reps {
+    for _ in 0..args.reps(n) {
         let t0 = Instant::now();
         let sol = res.solve_normal(&prob).expect("Hertz solve");
         times.push(t0.elapsed().as_secs_f64());
@@ -131,8 +156,8 @@ fn hertz(n: usize, args: &Args, res: &mut Resident, options: NormalOptions) {
         });
         // FFT floor of one fine iteration: the padded transforms of its operator
         // applications, plus (preconditioned) one unpadded periodic pair.
-        let pair = fft_pair_seconds(Fft2::new(n), &sol.p, args.reps);
-        let periodic = fft_pair_seconds(Fft2::periodic(n), &sol.p, args.reps);
+        let pair = fft_pair_seconds(Fft2::new(n), &sol.p, args.reps(n));
+        let periodic = fft_pair_seconds(Fft2::periodic(n), &sol.p, args.reps(n));
         let its = sol.report.iterations as f64;
         let apps = (sol.report.applications + 1) as f64;
         let iter_s = median(times) / its;
@@ -333,7 +358,12 @@ fn main() {
         let g = grid(n);
         let mut res = Resident::new(build_operator(&material, g));
         res.set_threads(&threads);
-        for (nested, precondition) in [(true, true), (false, true), (false, false)] {
+        let modes: &[(bool, bool)] = if n >= args.headline_from {
+            &[(true, true)]
+        } else {
+            &[(true, true), (false, true), (false, false)]
+        };
+        for &(nested, precondition) in modes {
             let options = NormalOptions {
                 nested,
                 precondition,

@@ -228,7 +228,9 @@ pub const MIN_RESOLVED_CELLS: f64 = 2.0;
 /// tractions, radii, shifts, forces and μa with the isotropic-equivalent K_E.
 /// `started` is when the solve began (for `seconds`). With a load path's
 /// `history`, a final state without a resolved slip annulus (everything
-/// sticks, as under proportional loading) is a result, with μa `None`.
+/// sticks, as under proportional loading) is a result, with μa `None`; so is
+/// the state of an unconverged solve (flagged by `converged`), whose radii
+/// are not checked against the grid.
 pub(crate) fn reduce(
     spec: &CaseSpec,
     op: &mut Operator,
@@ -285,7 +287,11 @@ pub(crate) fn reduce(
     // A zone a few cells across has no radius worth reporting: μa from
     // it is grid noise (a stick zone of a few cells gave μa = 434, #20 item 8).
     let min_radius = MIN_RESOLVED_CELLS * grid.dx.max(grid.dy);
-    if a < min_radius {
+    // An unconverged solve is flagged as such: its radii are those of an
+    // intermediate iterate, and calling it unresolved would send the user to
+    // refine a grid that was not the problem.
+    let converged = normal_report.converged && tan_report.converged && coupling_converged;
+    if converged && a < min_radius {
         return Err(SolverError::ContactUnresolved {
             detail: format!(
                 "a = {a:.3e} m spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m",
@@ -293,7 +299,7 @@ pub(crate) fn reduce(
             ),
         });
     }
-    if fnorm > 0.0 && c < min_radius && !is_history {
+    if converged && fnorm > 0.0 && c < min_radius && !is_history {
         return Err(SolverError::SlipUnresolved {
             detail: format!(
                 "the stick zone, c = {c:.3e} m, spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m (F/μP = {} leaves almost no stick)",
@@ -354,7 +360,7 @@ pub(crate) fn reduce(
         hertz_pressure_pa: 3.0 * load / (2.0 * std::f64::consts::PI * hertz_radius * hertz_radius),
         normal_force_n: p.iter().sum::<f64>() * da,
         tangential_force_n: [qx.iter().sum::<f64>() * da, qy.iter().sum::<f64>() * da],
-        converged: normal_report.converged && tan_report.converged && coupling_converged,
+        converged,
         normal_iterations,
         tangential_iterations,
         coupling_iterations: coupling_iterations.max(1),
@@ -366,7 +372,7 @@ pub(crate) fn reduce(
         history,
     };
     let annulus = c < a && c_sub < a_sub && c >= min_radius;
-    if fnorm > 0.0 && is_history {
+    if fnorm > 0.0 && (is_history || !converged) {
         if annulus {
             s.mu_a = Some(mu_apparent(&s, load, s.k_e));
             s.mu_a_cells = mu_apparent_cells(&s, load, s.k_e_cells);

@@ -276,3 +276,26 @@ fn a_start_set_with_equal_gaps_admits_the_cells_that_interpenetrate() {
     let load = normal.p.iter().sum::<f64>() * da;
     assert!((load / spec.load.normal_force_n - 1.0).abs() < 1e-12);
 }
+
+/// An unconverged solve is flagged as not converged, not reported as a grid
+/// that does not resolve the slip zone: near gross sliding (F = 0.995 μP) the
+/// converged stick zone spans less than two cells (SlipUnresolved), but
+/// stopped after 40 iterations the tangential solve has not converged, and
+/// that is what the case must say.
+#[test]
+fn an_unconverged_solve_is_flagged_not_called_unresolved() {
+    let mut spec = table_1c("Ni", "flat", 32, 200.0, 0.0);
+    spec.numerics.coupling = false;
+    spec.load.tangential_ratio = 0.995;
+    match solve_case(&spec, &mut KernelCache::new()) {
+        Err(solver::SolverError::SlipUnresolved { .. }) => {}
+        other => panic!("{:?}", other.map(|o| o.scalars)),
+    }
+    spec.numerics.max_iterations = 40;
+    let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
+    let s = &out.scalars;
+    assert!(
+        s.normal.converged && !s.tangential.converged && !s.converged,
+        "{s:?}"
+    );
+}
