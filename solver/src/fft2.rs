@@ -26,14 +26,26 @@ pub mod timing {
     thread_local! {
         static ON: Cell<bool> = const { Cell::new(false) };
         static SECONDS: Cell<f64> = const { Cell::new(0.0) };
+        static PRODUCTS: Cell<f64> = const { Cell::new(0.0) };
         static SPANS: Cell<u64> = const { Cell::new(0) };
+        static PRODUCT_SPANS: Cell<u64> = const { Cell::new(0) };
     }
 
     /// Starts timing this thread's transforms from zero.
     pub fn start() {
         ON.set(true);
         SECONDS.set(0.0);
+        PRODUCTS.set(0.0);
         SPANS.set(0);
+        PRODUCT_SPANS.set(0);
+    }
+
+    /// Seconds spent in the operator's spectral products (the one read of
+    /// the kernel spectra per application, [`Span::product`]) since
+    /// [`start`], and the number of their spans ([`stop`] counts only the
+    /// transforms').
+    pub fn products() -> (f64, u64) {
+        (PRODUCTS.get(), PRODUCT_SPANS.get())
     }
 
     /// Stops timing; returns the seconds spent in transforms and the number
@@ -45,23 +57,34 @@ pub mod timing {
     }
 
     /// One timed span: from its creation to its drop, when timing is on.
-    pub struct Span(Option<Instant>);
+    pub struct Span(Option<(Instant, bool)>);
 
     impl Span {
-        /// Starts a span (a no-op unless timing is on).
+        /// Starts a span of transforms (a no-op unless timing is on).
         #[inline]
         #[allow(clippy::new_without_default)]
         pub fn new() -> Self {
-            Span(ON.get().then(Instant::now))
+            Span(ON.get().then(|| (Instant::now(), false)))
+        }
+
+        /// Starts a span of spectral products (see [`products`]).
+        #[inline]
+        pub fn product() -> Self {
+            Span(ON.get().then(|| (Instant::now(), true)))
         }
     }
 
     impl Drop for Span {
         #[inline]
         fn drop(&mut self) {
-            if let Some(t) = self.0 {
-                SECONDS.set(SECONDS.get() + t.elapsed().as_secs_f64());
-                SPANS.set(SPANS.get() + 1);
+            if let Some((t, product)) = self.0 {
+                let (acc, count) = if product {
+                    (&PRODUCTS, &PRODUCT_SPANS)
+                } else {
+                    (&SECONDS, &SPANS)
+                };
+                acc.set(acc.get() + t.elapsed().as_secs_f64());
+                count.set(count.get() + 1);
             }
         }
     }

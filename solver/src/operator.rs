@@ -549,7 +549,10 @@ impl Operator {
                 }
                 let r = kx * m..(kx + 1) * m;
                 let kc = k.map(|row| row.map(|kr| kr.part(r.clone())));
-                mix(&kc, ns, nd, c0, c1);
+                {
+                    let _span = crate::fft2::timing::Span::product();
+                    mix(&kc, ns, nd, c0, c1);
+                }
                 cols.inverse(c0);
                 if nd > 1 {
                     cols.inverse(c1);
@@ -590,6 +593,7 @@ impl Operator {
                 cols.forward(c1);
                 // A half spectrum: columns 0 < kx < M/2 stand for their mirror too.
                 let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
+                let _span = crate::fft2::timing::Span::product();
                 weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col])
             });
         let mut sum = 0.0;
