@@ -308,6 +308,7 @@ pub(crate) fn solve_step(
                 .sum::<f64>()
                 * da
                 / load;
+            rescale_slip(&mut tan, &p, &nsol.p);
             p = nsol.p;
             approach = nsol.approach;
             // One more tangential solve at the updated pressure closes the loop.
@@ -328,4 +329,21 @@ pub(crate) fn solve_step(
         coupling_change,
         coupling_converged,
     })
+}
+
+/// Keeps the slip cells of `tan` on the rims of their friction discs when the
+/// pressure changes from `p_old` to `p_new` between coupling passes: their
+/// tractions are scaled by `p_new / p_old`, so that the next pass starts from
+/// the slip zone the last one ended with. (Kept as they were, the slip cells
+/// whose pressure rose started the next pass inside their discs, as stick
+/// cells with slip: on Table 1a, 160 tangential iterations over the passes
+/// against 93 with the rescaling at 512², 197 against 157 at 1024².)
+fn rescale_slip(tan: &mut TangentialSolution, p_old: &[f64], p_new: &[f64]) {
+    for i in 0..p_old.len() {
+        if p_old[i] > 0.0 && !tan.stick[i] {
+            let r = p_new[i].max(0.0) / p_old[i];
+            tan.qx[i] *= r;
+            tan.qy[i] *= r;
+        }
+    }
 }

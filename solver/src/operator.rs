@@ -200,6 +200,7 @@ pub struct Operator {
     /// One value per column of a column pass (the energy product's terms).
     column_values: Vec<f64>,
     tangential_bound: f64,
+    tangential_self: f64,
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian
@@ -214,6 +215,20 @@ fn tangential_symbol_max(s: &Spectra) -> f64 {
         best = best.max(mean + disc);
     }
     best
+}
+
+/// The mean of `K_xx(0, 0)` and `K_yy(0, 0)`, a cell's tangential
+/// displacement under a unit traction on itself: the mean of the two spectra
+/// over the full `m x m` grid (the inner columns of a half spectrum stand for
+/// their mirrors too).
+fn tangential_self(s: &Spectra, m: usize) -> f64 {
+    let mut sum = 0.0;
+    for (kx, (a, d)) in s.diag[X].chunks(m).zip(s.diag[Y].chunks(m)).enumerate() {
+        let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
+        let col: f64 = a.iter().zip(d).map(|(a, d)| a + d).sum();
+        sum += weight * col;
+    }
+    0.5 * sum / (m as f64 * m as f64)
 }
 
 /// The kernel values of row `iy` of the `2N x 2N` wrap-around grid
@@ -372,6 +387,7 @@ impl Operator {
         Operator {
             grid,
             tangential_bound: tangential_symbol_max(&spectra),
+            tangential_self: tangential_self(&spectra, fft.padded_len()),
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
             column_values: vec![0.0; fft.padded_len() / 2 + 1],
@@ -609,6 +625,13 @@ impl Operator {
         self.tangential_bound
     }
 
+    /// The mean of `K_xx` and `K_yy` at zero offset (m/Pa): a cell's own
+    /// tangential compliance, the diagonal of the tangential block (computed
+    /// once at construction).
+    pub fn tangential_self(&self) -> f64 {
+        self.tangential_self
+    }
+
     /// Normal displacement under pressure only: `uz = K_zz * p`.
     pub fn normal(&mut self, p: &[f64], uz: &mut [f64]) {
         self.apply(&[(Z, p)], &mut [(Z, uz)]);
@@ -641,6 +664,24 @@ mod tests {
                 ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.3
             })
             .collect()
+    }
+
+    /// A cell's own tangential compliance, from the spectra, is the mean of
+    /// the closed-form `K_xx(0, 0)` and `K_yy(0, 0)` (dx ≠ dy, so they differ).
+    #[test]
+    fn tangential_self_is_the_cells_own_compliance() {
+        let grid = Grid {
+            n: 24,
+            dx: 1.0e-6,
+            dy: 1.7e-6,
+        };
+        let (g, nu) = (80.0e9, 0.3);
+        let op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
+        let k = isotropic_cell(g, nu, 0.0, 0.0, grid.dx, grid.dy);
+        let want = 0.5 * (k[X][X] + k[Y][Y]);
+        assert!(k[X][X] != k[Y][Y]);
+        let err = (op.tangential_self() - want).abs() / want;
+        assert!(err < 1e-12, "{} vs {want}: {err:e}", op.tangential_self());
     }
 
     #[test]

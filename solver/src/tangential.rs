@@ -525,20 +525,42 @@ const CG_STALL: usize = 60;
 const REFRESH: usize = 32;
 
 /// Projected conjugate gradient for the disc-constrained problem, in the
-/// manner of Polonsky & Keer's normal solver: conjugate directions on the
-/// stick cells (|q_i| < μp_i) with the mean slip over them as the rigid
-/// shift δt (which keeps ΔA Σq = F), a projected-gradient move of the slip
-/// cells with the same step (rotation towards −slip, or release inwards),
-/// then the exact projection onto discs ∩ force. Conjugacy restarts whenever
-/// a cell enters or leaves the slip set. Returns with `converged` false if the
-/// KKT residual stops improving; the caller then continues with FISTA.
+/// manner of Polonsky & Keer's normal solver, with the slip cells' rotation
+/// among the conjugate variables. The variables are the stick cells'
+/// tractions (|q_i| < μp_i, two per cell) and each slip cell's move along the
+/// tangent `t_i` of its disc (|q_i| = μp_i, one per cell). The residual is the
+/// slip relative to the rigid shift, `u_i − d` on stick cells and its
+/// tangential part on slip cells, made orthogonal to the force constraint
+/// ΔA Σq = F; the step length sees the elastic energy of the direction and,
+/// on slip cells, the curvature of the disc's rim, `c_i = |n_i · (u_i − d)| /
+/// (μ p_i)` per unit tangential move (`n_i` the traction's direction: the
+/// slip pressing the traction onto the rim). The residual is preconditioned by
+/// the diagonal of that Hessian (Jacobi), with the cells' elastic stiffness
+/// taken as that of the last step, 1/τ: a slip cell's move is its Newton
+/// rotation where its rim is stiff and a conjugate-gradient move where it is
+/// not. Slip cells whose rim is stiffer than 1000/τ (pressures a millionth of
+/// the peak at the contact's edge) take the plain projected-gradient step
+/// instead, which aligns them in one step; a slip cell whose slip turns along
+/// its traction is released inwards by the gradient step. The trial point is
+/// projected exactly onto discs ∩ force. As in Polonsky & Keer, conjugacy
+/// restarts when a cell is released into the stick set, not when a stick
+/// cell reaches its disc. Returns with `converged` false if the KKT residual
+/// stops improving; the caller then continues with FISTA.
+///
+/// (Moving every slip cell by the plain projected-gradient step with the
+/// stick cells' step length, and restarting at every change of the stick
+/// set, left a tail in which the stick residual was below 1e-8 |δt| while
+/// the slip cells' alignment fell from 3e-6 to 1e-6 over 80–100 iterations,
+/// and warm starts that were steepest descent. Table 1a, fine iterations
+/// after the coarse start, Cattaneo–Mindlin at 256² / 512² / 1024² / 2048²:
+/// 213 / 164 / 174 / 193, now 38 / 48 / 63 / 94; coupled at 512² / 1024² /
+/// 2048²: 250 / 329 / 444, now 93 / 157 / 158. docs/performance.md has the
+/// table.)
 ///
 /// Per iteration: the step length needs `⟨t, C t⟩` of the direction, taken
 /// from its spectra by Parseval (two forward transforms), and the slip field
 /// is updated by `C Δq` of the actual move (one tangential application):
-/// six padded transforms. The direction sums to zero over the stick cells
-/// (the mean slip is removed and conjugacy restarts when the set changes), so
-/// the rigid shift's change drops out of the step length.
+/// six padded transforms.
 fn cg_disc(
     op: &mut Operator,
     prob: &TangentialProblem,
@@ -551,14 +573,19 @@ fn cg_disc(
     let Feasible { cells, bound, .. } = *set;
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
-    let (mut tx, mut ty) = (vec![0.0; len], vec![0.0; len]);
+    // The cells' elastic stiffness in the preconditioner, m/Pa: a cell's own
+    // compliance for the first step, then 1/τ of the last step.
+    let mut stiffness = op.tangential_self();
+    // The direction as a shear field: two components on stick cells, along
+    // the tangent on slip cells, zero elsewhere.
+    let (mut vx, mut vy) = (vec![0.0; len], vec![0.0; len]);
     let (mut dqx, mut dqy) = (vec![0.0; len], vec![0.0; len]);
     // Stick set of the current tractions: here, then after each projection.
     let mut stick = vec![false; len];
     for &i in cells {
         stick[i] = !on_bound(qx[i], qy[i], bound[i]);
     }
-    let mut g_old = 1.0;
+    let mut rz_old = 1.0;
     let mut conj = false;
     // The slip field in (ux, uy) is exact (`fresh`) or updated since `age` moves.
     let mut fresh = false;
@@ -598,20 +625,44 @@ fn cg_disc(
         }
         let d = [mx / ns as f64, my / ns as f64];
         out.shift = d;
-        // KKT residual relative to |δt|; the stick-set gradient norm.
+        // A slip cell's traction direction n, tangent t, rim curvature c and
+        // Jacobi weight k (0: aligned by its own gradient step).
+        let rim = |i: usize| -> SlipCell {
+            let qn = norm(qx[i], qy[i]);
+            let n = [qx[i] / qn, qy[i] / qn];
+            let press = -((ux[i] - d[0]) * n[0] + (uy[i] - d[1]) * n[1]);
+            let c = press.max(0.0) / bound[i];
+            let k = if c > STIFF_RIM * stiffness {
+                0.0
+            } else {
+                1.0 / (1.0 + c / stiffness)
+            };
+            SlipCell {
+                n,
+                t: [-n[1], n[0]],
+                c,
+                k,
+            }
+        };
+        // KKT residual relative to |δt|, and the weighted Gram matrix of the
+        // force constraint, A M⁻¹ Aᵀ = n_stick I + Σ_slip k t tᵀ.
         let scale = d[0].hypot(d[1]).max(f64::MIN_POSITIVE);
-        let (mut kkt_stick, mut kkt_slip, mut gg) = (0.0_f64, 0.0_f64, 0.0);
+        let (mut kkt_stick, mut kkt_slip) = (0.0_f64, 0.0_f64);
+        let mut gram = [[ns as f64, 0.0], [0.0, ns as f64]];
         for &i in cells {
             let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
             if stick[i] {
                 kkt_stick = kkt_stick.max(norm(wx, wy));
-                gg += wx * wx + wy * wy;
             } else {
-                let qn = norm(qx[i], qy[i]);
+                let SlipCell { n, t, k, .. } = rim(i);
                 let w = norm(wx, wy);
-                kkt_slip = kkt_slip.max(norm(wx + w * qx[i] / qn, wy + w * qy[i] / qn));
+                kkt_slip = kkt_slip.max(norm(wx + w * n[0], wy + w * n[1]));
+                gram[0][0] += k * t[0] * t[0];
+                gram[0][1] += k * t[0] * t[1];
+                gram[1][1] += k * t[1] * t[1];
             }
         }
+        gram[1][0] = gram[0][1];
         out.kkt = kkt_stick.max(kkt_slip) / scale;
 
         if out.kkt < prob.tolerance {
@@ -633,46 +684,116 @@ fn cg_disc(
                 return Ok(out);
             }
         }
-        // Conjugate direction on the stick cells. (A |k| Fourier preconditioner,
-        // which cuts the normal iterations 4x, made this iteration stall: the
-        // slip cells' moves no longer matched the stick cells' steps.)
-        let beta = if conj { gg / g_old } else { 0.0 };
-        g_old = gg;
-        // Outside the contact cells t (like Δq below) stays zero.
-        let mut num = 0.0;
+        // The preconditioned residual z = M⁻¹ (u − Aᵀ m), orthogonal to the
+        // force constraint (A z = 0): m solves A M⁻¹ Aᵀ m = A M⁻¹ u.
+        let mut rhs = [0.0; 2];
         for &i in cells {
             if stick[i] {
-                let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
-                tx[i] = wx + beta * tx[i];
-                ty[i] = wy + beta * ty[i];
-                num += wx * tx[i] + wy * ty[i];
+                rhs[0] += ux[i];
+                rhs[1] += uy[i];
             } else {
-                tx[i] = 0.0;
-                ty[i] = 0.0;
+                let SlipCell { t, k, .. } = rim(i);
+                let rt = k * (t[0] * ux[i] + t[1] * uy[i]);
+                rhs[0] += t[0] * rt;
+                rhs[1] += t[1] * rt;
             }
         }
-        let den = op.tangential_energy(&tx, &ty);
+        let m = solve2(gram, rhs);
+        // Conjugate direction v = z + β v_old (the old one taken along the
+        // current tangent on slip cells), then made orthogonal to the force
+        // constraint again, as the tangents turned a little since.
+        let mut rz = 0.0;
+        for &i in cells {
+            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
+            if stick[i] {
+                rz += rx * rx + ry * ry;
+            } else {
+                let SlipCell { t, k, .. } = rim(i);
+                let rt = t[0] * rx + t[1] * ry;
+                rz += k * rt * rt;
+            }
+        }
+        let beta = if conj { rz / rz_old } else { 0.0 };
+        rz_old = rz;
+        let mut rhs = [0.0; 2];
+        for &i in cells {
+            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
+            if stick[i] {
+                vx[i] = rx + beta * vx[i];
+                vy[i] = ry + beta * vy[i];
+                rhs[0] += vx[i];
+                rhs[1] += vy[i];
+            } else {
+                let SlipCell { t, k, .. } = rim(i);
+                let s = if k > 0.0 {
+                    k * (t[0] * rx + t[1] * ry) + beta * (t[0] * vx[i] + t[1] * vy[i])
+                } else {
+                    0.0
+                };
+                vx[i] = s * t[0];
+                vy[i] = s * t[1];
+                rhs[0] += t[0] * s;
+                rhs[1] += t[1] * s;
+            }
+        }
+        // v −= M⁻¹ Aᵀ m2 with A M⁻¹ Aᵀ m2 = A v, so that A v = 0.
+        let m2 = solve2(gram, rhs);
+        let (mut num, mut bend) = (0.0, 0.0);
+        for &i in cells {
+            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
+            if stick[i] {
+                vx[i] -= m2[0];
+                vy[i] -= m2[1];
+                num += rx * vx[i] + ry * vy[i];
+            } else {
+                let SlipCell { t, c, k, .. } = rim(i);
+                let s = t[0] * vx[i] + t[1] * vy[i] - k * (t[0] * m2[0] + t[1] * m2[1]);
+                vx[i] = s * t[0];
+                vy[i] = s * t[1];
+                num += (t[0] * rx + t[1] * ry) * s;
+                bend += c * s * s;
+            }
+        }
+        if num <= 0.0 {
+            // Not a descent direction: the old direction no longer conjugate
+            // (restart), or no residual left to reduce (FISTA takes over).
+            if !conj {
+                return Ok(out);
+            }
+            conj = false;
+            continue;
+        }
+        let den = op.tangential_energy(&vx, &vy) + bend;
         out.energy_products += 1;
         if den <= 0.0 || !den.is_finite() {
             return Ok(out);
         }
         let tau = num / den;
-        // Trial point: CG step on stick cells, projected-gradient step on slip
-        // cells; Δq holds the current tractions until the projection.
+        // Trial point: the conjugate step; on slip cells outside the
+        // conjugate directions the projected-gradient step, and on slip cells
+        // whose slip runs along their traction the inward gradient step that
+        // releases them. Δq holds the current tractions until the projection.
         for &i in cells {
             dqx[i] = qx[i];
             dqy[i] = qy[i];
-            if stick[i] {
-                zx[i] = qx[i] - tau * tx[i];
-                zy[i] = qy[i] - tau * ty[i];
-            } else {
-                // Slip cells move in every iteration: holding them until their
-                // violation dominated saved an application per iteration but
-                // converged about 50x slower on the paper's cases.
-                zx[i] = qx[i] - tau * (ux[i] - d[0]);
-                zy[i] = qy[i] - tau * (uy[i] - d[1]);
+            zx[i] = qx[i] - tau * vx[i];
+            zy[i] = qy[i] - tau * vy[i];
+            if !stick[i] {
+                let SlipCell { n, k, .. } = rim(i);
+                let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
+                if k == 0.0 {
+                    zx[i] = qx[i] - tau * wx;
+                    zy[i] = qy[i] - tau * wy;
+                } else {
+                    let along = wx * n[0] + wy * n[1];
+                    if along > 0.0 {
+                        zx[i] -= tau * along * n[0];
+                        zy[i] -= tau * along * n[1];
+                    }
+                }
             }
         }
+        stiffness = 1.0 / tau;
         // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
         let mut l = [0.0; 2];
         project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy)).ok_or_else(|| {
@@ -680,16 +801,17 @@ fn cg_disc(
                 detail: "no traction field satisfies both the friction discs and the force".into(),
             }
         })?;
-        // The new stick set, whether it changed, and Δq of the move.
-        let mut changed = false;
+        // The new stick set, whether a cell was released into it, and Δq of
+        // the move.
+        let mut released = false;
         for &i in cells {
             let sticks = !on_bound(qx[i], qy[i], bound[i]);
-            changed |= sticks != stick[i];
+            released |= sticks && !stick[i];
             stick[i] = sticks;
             dqx[i] = qx[i] - dqx[i];
             dqy[i] = qy[i] - dqy[i];
         }
-        conj = !changed;
+        conj = !released;
         // Slip field of the new tractions: u += C Δq.
         op.tangential_add(&dqx, &dqy, ux, uy);
         out.applications += 1;
@@ -697,4 +819,30 @@ fn cg_disc(
         age += 1;
     }
     Ok(out)
+}
+
+/// Rim stiffness, relative to the cells' elastic stiffness 1/τ, above which a
+/// slip cell is aligned by its own projected-gradient step rather than
+/// within the conjugate directions. (At 1e3 these are the cells at the
+/// contact's edge with pressures about 1e-12 of the peak, whose Jacobi weight
+/// would all but freeze them: without it, Table 1a coupled at 512² stalled
+/// with their misalignment at 5e-2 |δt|.)
+const STIFF_RIM: f64 = 1e3;
+
+/// A slip cell's traction direction `n`, the tangent `t` of its disc's rim,
+/// the rim's curvature `c` (m/Pa) and the cell's Jacobi weight `k`.
+struct SlipCell {
+    n: [f64; 2],
+    t: [f64; 2],
+    c: f64,
+    k: f64,
+}
+
+/// The solution of the symmetric positive definite 2x2 system `a x = b`.
+fn solve2(a: [[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
+    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    [
+        (a[1][1] * b[0] - a[0][1] * b[1]) / det,
+        (a[0][0] * b[1] - a[1][0] * b[0]) / det,
+    ]
 }
