@@ -585,6 +585,9 @@ fn cg_disc(
     for &i in cells {
         stick[i] = !on_bound(qx[i], qy[i], bound[i]);
     }
+    // This iteration's `SlipCell` of each slip cell, in the order of `cells`
+    // (the later passes of an iteration walk `cells` in the same order).
+    let mut rims: Vec<SlipCell> = Vec::new();
     let mut rz_old = 1.0;
     let mut conj = false;
     // The slip field in (ux, uy) is exact (`fresh`) or updated since `age` moves.
@@ -637,29 +640,33 @@ fn cg_disc(
             } else {
                 1.0 / (1.0 + c / stiffness)
             };
-            SlipCell {
-                n,
-                t: [-n[1], n[0]],
-                c,
-                k,
-            }
+            SlipCell { n, c, k }
         };
-        // KKT residual relative to |δt|, and the weighted Gram matrix of the
-        // force constraint, A M⁻¹ Aᵀ = n_stick I + Σ_slip k t tᵀ.
+        // KKT residual relative to |δt|; the weighted Gram matrix of the force
+        // constraint, A M⁻¹ Aᵀ = n_stick I + Σ_slip k t tᵀ, and A M⁻¹ u.
         let scale = d[0].hypot(d[1]).max(f64::MIN_POSITIVE);
         let (mut kkt_stick, mut kkt_slip) = (0.0_f64, 0.0_f64);
         let mut gram = [[ns as f64, 0.0], [0.0, ns as f64]];
+        let mut rhs = [0.0; 2];
+        rims.clear();
         for &i in cells {
             let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
             if stick[i] {
                 kkt_stick = kkt_stick.max(norm(wx, wy));
+                rhs[0] += ux[i];
+                rhs[1] += uy[i];
             } else {
-                let SlipCell { n, t, k, .. } = rim(i);
+                let cell = rim(i);
+                let (n, t, k) = (cell.n, cell.t(), cell.k);
                 let w = norm(wx, wy);
                 kkt_slip = kkt_slip.max(norm(wx + w * n[0], wy + w * n[1]));
                 gram[0][0] += k * t[0] * t[0];
                 gram[0][1] += k * t[0] * t[1];
                 gram[1][1] += k * t[1] * t[1];
+                let rt = k * (t[0] * ux[i] + t[1] * uy[i]);
+                rhs[0] += t[0] * rt;
+                rhs[1] += t[1] * rt;
+                rims.push(cell);
             }
         }
         gram[1][0] = gram[0][1];
@@ -686,29 +693,19 @@ fn cg_disc(
         }
         // The preconditioned residual z = M⁻¹ (u − Aᵀ m), orthogonal to the
         // force constraint (A z = 0): m solves A M⁻¹ Aᵀ m = A M⁻¹ u.
-        let mut rhs = [0.0; 2];
-        for &i in cells {
-            if stick[i] {
-                rhs[0] += ux[i];
-                rhs[1] += uy[i];
-            } else {
-                let SlipCell { t, k, .. } = rim(i);
-                let rt = k * (t[0] * ux[i] + t[1] * uy[i]);
-                rhs[0] += t[0] * rt;
-                rhs[1] += t[1] * rt;
-            }
-        }
         let m = solve2(gram, rhs);
         // Conjugate direction v = z + β v_old (the old one taken along the
         // current tangent on slip cells), then made orthogonal to the force
         // constraint again, as the tangents turned a little since.
         let mut rz = 0.0;
+        let mut slip = rims.iter();
         for &i in cells {
             let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
             if stick[i] {
                 rz += rx * rx + ry * ry;
             } else {
-                let SlipCell { t, k, .. } = rim(i);
+                let cell = slip.next().expect("one per slip cell");
+                let (t, k) = (cell.t(), cell.k);
                 let rt = t[0] * rx + t[1] * ry;
                 rz += k * rt * rt;
             }
@@ -716,6 +713,7 @@ fn cg_disc(
         let beta = if conj { rz / rz_old } else { 0.0 };
         rz_old = rz;
         let mut rhs = [0.0; 2];
+        let mut slip = rims.iter();
         for &i in cells {
             let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
             if stick[i] {
@@ -724,7 +722,8 @@ fn cg_disc(
                 rhs[0] += vx[i];
                 rhs[1] += vy[i];
             } else {
-                let SlipCell { t, k, .. } = rim(i);
+                let cell = slip.next().expect("one per slip cell");
+                let (t, k) = (cell.t(), cell.k);
                 let s = if k > 0.0 {
                     k * (t[0] * rx + t[1] * ry) + beta * (t[0] * vx[i] + t[1] * vy[i])
                 } else {
@@ -739,6 +738,7 @@ fn cg_disc(
         // v −= M⁻¹ Aᵀ m2 with A M⁻¹ Aᵀ m2 = A v, so that A v = 0.
         let m2 = solve2(gram, rhs);
         let (mut num, mut bend) = (0.0, 0.0);
+        let mut slip = rims.iter();
         for &i in cells {
             let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
             if stick[i] {
@@ -746,7 +746,8 @@ fn cg_disc(
                 vy[i] -= m2[1];
                 num += rx * vx[i] + ry * vy[i];
             } else {
-                let SlipCell { t, c, k, .. } = rim(i);
+                let cell = slip.next().expect("one per slip cell");
+                let (t, c, k) = (cell.t(), cell.c, cell.k);
                 let s = t[0] * vx[i] + t[1] * vy[i] - k * (t[0] * m2[0] + t[1] * m2[1]);
                 vx[i] = s * t[0];
                 vy[i] = s * t[1];
@@ -773,13 +774,15 @@ fn cg_disc(
         // conjugate directions the projected-gradient step, and on slip cells
         // whose slip runs along their traction the inward gradient step that
         // releases them. Δq holds the current tractions until the projection.
+        let mut slip = rims.iter();
         for &i in cells {
             dqx[i] = qx[i];
             dqy[i] = qy[i];
             zx[i] = qx[i] - tau * vx[i];
             zy[i] = qy[i] - tau * vy[i];
             if !stick[i] {
-                let SlipCell { n, k, .. } = rim(i);
+                let cell = slip.next().expect("one per slip cell");
+                let (n, k) = (cell.n, cell.k);
                 let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
                 if k == 0.0 {
                     zx[i] = qx[i] - tau * wx;
@@ -829,13 +832,19 @@ fn cg_disc(
 /// with their misalignment at 5e-2 |δt|.)
 const STIFF_RIM: f64 = 1e3;
 
-/// A slip cell's traction direction `n`, the tangent `t` of its disc's rim,
-/// the rim's curvature `c` (m/Pa) and the cell's Jacobi weight `k`.
+/// A slip cell's traction direction `n`, the curvature `c` of its disc's rim
+/// (m/Pa) and the cell's Jacobi weight `k`.
 struct SlipCell {
     n: [f64; 2],
-    t: [f64; 2],
     c: f64,
     k: f64,
+}
+
+impl SlipCell {
+    /// The unit tangent of the rim at the traction.
+    fn t(&self) -> [f64; 2] {
+        [-self.n[1], self.n[0]]
+    }
 }
 
 /// The solution of the symmetric positive definite 2x2 system `a x = b`.
