@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::config::Config;
-use crate::cost::{case_seconds, kernel_seconds};
+use crate::cost::{case_seconds, kernel_seconds, CASE_EXPONENT};
 use solver::KernelKey;
 
 fn human_seconds(s: f64) -> String {
@@ -119,7 +119,7 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
             .sum::<f64>();
     let _ = writeln!(
         s,
-        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^2.5; a guide within a factor of 2)",
+        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^{CASE_EXPONENT}; a guide within a factor of 2)",
         human_seconds(total / workers_used as f64),
         solving / cases.len() as f64
     );
