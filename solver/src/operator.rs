@@ -670,11 +670,7 @@ mod tests {
     /// the closed-form `K_xx(0, 0)` and `K_yy(0, 0)` (dx ≠ dy, so they differ).
     #[test]
     fn tangential_self_is_the_cells_own_compliance() {
-        let grid = Grid {
-            n: 24,
-            dx: 1.0e-6,
-            dy: 1.7e-6,
-        };
+        let grid = grid(24, 1.0e-6, 1.7e-6);
         let (g, nu) = (80.0e9, 0.3);
         let op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
         let k = isotropic_cell(g, nu, 0.0, 0.0, grid.dx, grid.dy);
