@@ -190,14 +190,9 @@ fn project(
             *lambda = l;
             return Some(());
         }
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let (mut dx, mut dy) = if det.abs() > 1e-300 {
-            (
-                -(j[1][1] * f[0] - j[0][1] * f[1]) / det,
-                -(-j[1][0] * f[0] + j[0][0] * f[1]) / det,
-            )
-        } else {
-            (-f[0] / cells.len() as f64, -f[1] / cells.len() as f64)
+        let (mut dx, mut dy) = match solve2(j, f) {
+            Some([x, y]) => (-x, -y),
+            None => (-f[0] / cells.len() as f64, -f[1] / cells.len() as f64),
         };
         // Backtracking on |f| (f is the gradient of a convex function of λ).
         let mut accepted = false;
@@ -693,7 +688,10 @@ fn cg_disc(
         }
         // The preconditioned residual z = M⁻¹ (u − Aᵀ m), orthogonal to the
         // force constraint (A z = 0): m solves A M⁻¹ Aᵀ m = A M⁻¹ u.
-        let m = solve2(gram, rhs);
+        // (The Gram matrix holds n_stick ≥ 1 on its diagonal: never singular.)
+        let Some(m) = solve2(gram, rhs) else {
+            return Ok(out);
+        };
         // Conjugate direction v = z + β v_old (the old one taken along the
         // current tangent on slip cells), then made orthogonal to the force
         // constraint again, as the tangents turned a little since.
@@ -736,7 +734,9 @@ fn cg_disc(
             }
         }
         // v −= M⁻¹ Aᵀ m2 with A M⁻¹ Aᵀ m2 = A v, so that A v = 0.
-        let m2 = solve2(gram, rhs);
+        let Some(m2) = solve2(gram, rhs) else {
+            return Ok(out);
+        };
         let (mut num, mut bend) = (0.0, 0.0);
         let mut slip = rims.iter();
         for &i in cells {
@@ -847,11 +847,15 @@ impl SlipCell {
     }
 }
 
-/// The solution of the symmetric positive definite 2x2 system `a x = b`.
-fn solve2(a: [[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
+/// The solution of the 2x2 system `a x = b` by Cramer's rule, or `None`
+/// when `a` is singular to working precision (|det| ≤ 1e-300): the Newton
+/// step of [`project`] and the force-constraint multipliers of [`cg_disc`].
+fn solve2(a: [[f64; 2]; 2], b: [f64; 2]) -> Option<[f64; 2]> {
     let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-    [
-        (a[1][1] * b[0] - a[0][1] * b[1]) / det,
-        (a[0][0] * b[1] - a[1][0] * b[0]) / det,
-    ]
+    (det.abs() > 1e-300).then(|| {
+        [
+            (a[1][1] * b[0] - a[0][1] * b[1]) / det,
+            (a[0][0] * b[1] - a[1][0] * b[0]) / det,
+        ]
+    })
 }
