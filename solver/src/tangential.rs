@@ -3,11 +3,15 @@
 //! force `ΔA Σ q = F` (force control). Sees only the operator's tangential block
 //! and an extra slip term supplied by the caller (normal–tangential coupling).
 //!
-//! Method: accelerated projected gradient (FISTA with adaptive restart) on the
-//! convex problem min ½qᵀCq + eᵀq over {|q_i| ≤ μp_i} ∩ {ΔA Σq = F}. The exact
-//! Euclidean projection onto that set shifts all tractions by one 2-D
-//! multiplier λ (found by Newton's method) before clipping them to their discs;
-//! λ divided by the step is the rigid shift δt of the sphere.
+//! Method: the convex problem min ½qᵀCq + eᵀq over {|q_i| ≤ μp_i} ∩
+//! {ΔA Σq = F}, solved by a projected conjugate gradient over the stick
+//! cells' tractions and the slip cells' rotation on their discs (`cg_disc`),
+//! and by accelerated projected gradient (FISTA with adaptive restart) from
+//! where it stopped if its KKT residual stalls. Both end on the exact
+//! Euclidean projection onto that set, which shifts all tractions by one 2-D
+//! multiplier λ (found by Newton's method) before clipping them to their
+//! discs; the rigid shift δt of the sphere is the stick cells' mean slip (CG)
+//! or λ divided by the step (FISTA).
 
 use crate::coarse_slip::{coarse_start, TangentialLevels};
 use crate::error::SolverError;
