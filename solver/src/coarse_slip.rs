@@ -137,7 +137,11 @@ pub(crate) fn coarse_start(
             },
             ..*prob
         };
-        let sol = match solve_tangential_on_grid(op, &sub) {
+        let solved = solve_tangential_on_grid(op, &sub);
+        // A level is used once per start: its work spectra are not kept
+        // between starts (see `Operator::release_work`).
+        op.release_work();
+        let sol = match solved {
             Ok(s) => s,
             Err(SolverError::GrossSliding { .. }) => return Ok(None),
             Err(e) => return Err(e),

@@ -20,12 +20,16 @@ const ANDERSON_DEPTH: usize = 3;
 /// Anderson acceleration (type II) of a fixed point `x = G(x)`: given
 /// `g = G(x_prev)`, replaces it by `g − ΔG γ` with `γ` minimising
 /// `|f − ΔF γ|`, `f = g − x_prev`, over the last `depth` differences.
+///
+/// The history holds the last `depth` pairs `(g, f)`, and the differences
+/// `ΔG`, `ΔF` are formed cell by cell where they are used: `2 depth + 1`
+/// fields instead of `2 depth` differences plus the last pair and `x_prev`
+/// (two fields fewer, 67 MB of a 2048² solve), with the same arithmetic.
 struct Anderson {
     depth: usize,
     x_prev: Vec<f64>,
-    last: Option<(Vec<f64>, Vec<f64>)>,
-    dg: VecDeque<Vec<f64>>,
-    df: VecDeque<Vec<f64>>,
+    /// `(g, f)` of the last calls since a reset, oldest first.
+    history: VecDeque<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Anderson {
@@ -33,50 +37,54 @@ impl Anderson {
         Anderson {
             depth,
             x_prev: vec![0.0; len],
-            last: None,
-            dg: Default::default(),
-            df: Default::default(),
+            history: VecDeque::new(),
         }
     }
 
     fn reset(&mut self) {
-        self.last = None;
-        self.dg.clear();
-        self.df.clear();
+        self.history.clear();
     }
 
     /// `g` holds G(x_prev) on entry and the next iterate on return.
     fn mix(&mut self, g: &mut [f64]) {
         let f: Vec<f64> = g.iter().zip(&self.x_prev).map(|(a, b)| a - b).collect();
-        if let Some((g_old, f_old)) = self.last.take() {
-            if self.dg.len() == self.depth {
-                self.dg.pop_front();
-                self.df.pop_front();
-            }
-            self.dg
-                .push_back(g.iter().zip(&g_old).map(|(a, b)| a - b).collect());
-            self.df
-                .push_back(f.iter().zip(&f_old).map(|(a, b)| a - b).collect());
+        self.history.push_back((g.to_vec(), f));
+        if self.history.len() > self.depth + 1 {
+            self.history.pop_front();
         }
-        let next_last = (g.to_vec(), f.clone());
-        let m = self.df.len();
+        // Difference i is between entries i and i + 1 (the last: this call's).
+        let h = &self.history;
+        let m = h.len() - 1;
         if m > 0 {
-            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-            let a = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&self.df[i], &self.df[j]));
-            let b = nalgebra::DVector::from_fn(m, |i, _| dot(&self.df[i], &f));
+            let f = &h[m].1;
+            let df_dot = |i: usize, j: usize| -> f64 {
+                let (a0, a1, b0, b1) = (&h[i].1, &h[i + 1].1, &h[j].1, &h[j + 1].1);
+                (0..f.len())
+                    .map(|c| (a1[c] - a0[c]) * (b1[c] - b0[c]))
+                    .sum::<f64>()
+            };
+            let a = nalgebra::DMatrix::from_fn(m, m, df_dot);
+            let b = nalgebra::DVector::from_fn(m, |i, _| {
+                let (a0, a1) = (&h[i].1, &h[i + 1].1);
+                (0..f.len()).map(|c| (a1[c] - a0[c]) * f[c]).sum::<f64>()
+            });
             let reg = 1e-12 * a.trace().max(f64::MIN_POSITIVE);
             let a = a + nalgebra::DMatrix::identity(m, m) * reg;
             if let Some(gamma) = a.cholesky().map(|c| c.solve(&b)) {
                 if gamma.iter().all(|v| v.is_finite()) {
-                    for (j, dgj) in self.dg.iter().enumerate() {
-                        for (gi, d) in g.iter_mut().zip(dgj) {
-                            *gi -= gamma[j] * d;
+                    for j in 0..m {
+                        let (g0, g1) = (&h[j].0, &h[j + 1].0);
+                        for (c, gi) in g.iter_mut().enumerate() {
+                            *gi -= gamma[j] * (g1[c] - g0[c]);
                         }
                     }
                 }
             }
         }
-        self.last = Some(next_last);
+        // Only `depth` pairs are needed by the next call.
+        if self.history.len() > self.depth {
+            self.history.pop_front();
+        }
         self.x_prev.copy_from_slice(g);
     }
 }
@@ -202,8 +210,6 @@ pub(crate) fn solve_step(
     // An increment of a history is solved even at zero force (unloading
     // passes through it with tractions locked in).
     if fnorm > 0.0 || previous.is_some() {
-        let (mut ex, mut ey) = (vec![0.0; len], vec![0.0; len]);
-        let mut hq = vec![0.0; len];
         // The pressure before tangential loading: the coupling term is the
         // tangential displacement of the pressure's change since then.
         let p0 = match previous {
@@ -245,43 +251,57 @@ pub(crate) fn solve_step(
                 )
             };
             let tan_tol = tan_tol * step.tolerance_scale;
+            // The slip terms (ex, ey), dp and hq live only while they are
+            // used: a pass's tangential and normal solves each hold only
+            // their own inputs (on Table 1a the two are the case's memory
+            // peaks, 2.2 and 2.3 times the stored spectra and nine fields).
+            let (mut ex, mut ey) = (vec![0.0; len], vec![0.0; len]);
             if num.coupling {
-                // hq is free until uz(q) is computed below.
-                for ((d, a), b) in hq.iter_mut().zip(&p).zip(&p0) {
-                    *d = a - b;
-                }
+                let dp: Vec<f64> = p.iter().zip(&p0).map(|(a, b)| a - b).collect();
                 res.operator
-                    .apply(&[(Z, &hq)], &mut [(X, &mut ex), (Y, &mut ey)]);
+                    .apply(&[(Z, &dp)], &mut [(X, &mut ex), (Y, &mut ey)]);
             }
             // Slip measured from the previous increment's state (uncoupled,
-            // there is one pass, so ex and ey are set once).
+            // there is one pass).
             if let Some(prev) = previous.filter(|_| num.coupling || k == 1) {
                 for i in 0..len {
                     ex[i] -= prev.u.0[i];
                     ey[i] -= prev.u.1[i];
                 }
             }
-            // The previous pass's slip is not an input: free it meanwhile.
+            // The initial (zero) slip is not an input: free it meanwhile.
             drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
-            let sol = res.solve_tangential(&TangentialProblem {
+            let prob = TangentialProblem {
                 p: &p,
                 friction: spec.load.friction,
                 force,
                 extra: has_extra.then_some((&ex[..], &ey[..])),
                 tolerance: tan_tol,
                 max_iterations: num.max_iterations,
-                start: match (have_q, previous) {
-                    (true, _) => TangentialStart::Tractions(&tan.qx, &tan.qy),
-                    (false, Some(prev)) => TangentialStart::Tractions(prev.start.0, prev.start.1),
-                    (false, None) => TangentialStart::Proportional,
+                start: match previous {
+                    Some(prev) => TangentialStart::Tractions(prev.start.0, prev.start.1),
+                    None => TangentialStart::Proportional,
                 },
-            })?;
+            };
+            // From the second pass on, the last pass's tractions start the
+            // solve, which takes them over (they are replaced by its own).
+            let sol = if have_q {
+                let start = (std::mem::take(&mut tan.qx), std::mem::take(&mut tan.qy));
+                res.solve_tangential_from(&prob, start)?
+            } else {
+                res.solve_tangential(&prob)?
+            };
             have_q = true;
             tangential_iterations += sol.report.iterations;
             tan = sol;
             if !num.coupling || coupling_converged {
                 break;
             }
+            // Another tangential solve follows this pass: its slip, and the
+            // slip terms, are not needed again.
+            drop((ex, ey));
+            drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
+            let mut hq = vec![0.0; len];
             res.operator
                 .apply(&[(X, &tan.qx), (Y, &tan.qy)], &mut [(Z, &mut hq)]);
             // Anderson mixing of the coupling gap uz(q) while the loop is far
@@ -367,6 +387,97 @@ fn rescale_slip(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The mixing with stored differences that [`Anderson`] replaced: `2
+    /// depth` difference fields, the last `(g, f)` and `x_prev`.
+    struct StoredDifferences {
+        depth: usize,
+        x_prev: Vec<f64>,
+        last: Option<(Vec<f64>, Vec<f64>)>,
+        dg: VecDeque<Vec<f64>>,
+        df: VecDeque<Vec<f64>>,
+    }
+
+    impl StoredDifferences {
+        fn mix(&mut self, g: &mut [f64]) {
+            let f: Vec<f64> = g.iter().zip(&self.x_prev).map(|(a, b)| a - b).collect();
+            if let Some((g_old, f_old)) = self.last.take() {
+                if self.dg.len() == self.depth {
+                    self.dg.pop_front();
+                    self.df.pop_front();
+                }
+                self.dg
+                    .push_back(g.iter().zip(&g_old).map(|(a, b)| a - b).collect());
+                self.df
+                    .push_back(f.iter().zip(&f_old).map(|(a, b)| a - b).collect());
+            }
+            let next_last = (g.to_vec(), f.clone());
+            let m = self.df.len();
+            if m > 0 {
+                let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+                let a = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&self.df[i], &self.df[j]));
+                let b = nalgebra::DVector::from_fn(m, |i, _| dot(&self.df[i], &f));
+                let reg = 1e-12 * a.trace().max(f64::MIN_POSITIVE);
+                let a = a + nalgebra::DMatrix::identity(m, m) * reg;
+                if let Some(gamma) = a.cholesky().map(|c| c.solve(&b)) {
+                    for (j, dgj) in self.dg.iter().enumerate() {
+                        for (gi, d) in g.iter_mut().zip(dgj) {
+                            *gi -= gamma[j] * d;
+                        }
+                    }
+                }
+            }
+            self.last = Some(next_last);
+            self.x_prev.copy_from_slice(g);
+        }
+    }
+
+    /// Differences formed where they are used give the iterates of stored
+    /// differences to the bit, through a full history and a reset, on a
+    /// contractive map (a damped rotation plus a cubic term).
+    #[test]
+    fn anderson_without_stored_differences_mixes_to_the_bit() {
+        let len = 257;
+        let map = |x: &[f64], k: usize| -> Vec<f64> {
+            (0..len)
+                .map(|i| {
+                    let j = (i * 7 + k) % len;
+                    0.6 * x[j] - 0.3 * x[i]
+                        + 0.05 * x[i].powi(3)
+                        + ((i * 13 + 5) % 17) as f64 * 1e-3
+                })
+                .collect()
+        };
+        let mut new = Anderson::new(3, len);
+        let mut old = StoredDifferences {
+            depth: 3,
+            x_prev: vec![0.0; len],
+            last: None,
+            dg: VecDeque::new(),
+            df: VecDeque::new(),
+        };
+        let (mut xa, mut xb) = (vec![0.1; len], vec![0.1; len]);
+        for k in 0..12 {
+            if k == 7 {
+                new.reset();
+                old.last = None;
+                old.dg.clear();
+                old.df.clear();
+            }
+            let (mut ga, mut gb) = (map(&xa, k), map(&xb, k));
+            new.mix(&mut ga);
+            old.mix(&mut gb);
+            for (a, b) in ga.iter().zip(&gb) {
+                assert_eq!(a.to_bits(), b.to_bits(), "iterate {k}");
+            }
+            // The mixing did something: the iterate is not the plain map's.
+            if k > 1 && k != 7 && k != 8 {
+                let plain = map(&xa, k);
+                assert!(ga.iter().zip(&plain).any(|(a, b)| a != b), "iterate {k}");
+            }
+            (xa, xb) = (ga, gb);
+        }
+    }
 
     #[test]
     fn rescaled_slip_stays_on_the_rims_and_new_contact_cells_start_on_theirs() {

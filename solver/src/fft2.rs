@@ -100,6 +100,8 @@ struct TaskBufs {
     /// `TILE` row spectra, `[row][kx]`.
     tile: Vec<Complex64>,
     scratch: Vec<Complex64>,
+    /// Two whole columns (`M` values each) of a [`Fft2::column_pass`].
+    columns: [Vec<Complex64>; 2],
 }
 
 /// A spectrum written by several tasks at once, each at indices no other
@@ -235,6 +237,7 @@ impl Fft2 {
             row_real: vec![0.0; self.m],
             tile: vec![Complex64::default(); TILE.min(self.m) * h],
             scratch: vec![Complex64::default(); self.scratch_len],
+            columns: std::array::from_fn(|_| vec![Complex64::default(); self.m]),
         }
     }
 
@@ -260,6 +263,15 @@ impl Fft2 {
         self.m * (self.m / 2 + 1)
     }
 
+    /// Number of complex values of a compact spectrum: the first `N` of the
+    /// `M` values of each column of a half spectrum, what the row stage of a
+    /// zero-padded field fills and the cropped inverse row stage reads (the
+    /// other `M − N` live only in a column pass's column, see
+    /// [`Fft2::column_pass`]). Half of [`Fft2::spectrum_len`] for a padded grid.
+    pub fn compact_len(&self) -> usize {
+        self.n * (self.m / 2 + 1)
+    }
+
     /// Forward transform of a full `M x M` real array (used for kernels).
     pub fn forward_full(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
@@ -275,24 +287,31 @@ impl Fft2 {
     }
 
     /// Row stage of [`Fft2::forward_padded`]: the row transforms of the `N`
-    /// non-zero rows, in place in the transposed spectrum. Entries `N..M` of
-    /// each column are left as they were; [`Columns::forward`] (in a
-    /// [`Fft2::column_pass`]) zeroes and transforms one column, so a caller
+    /// non-zero rows, into a compact spectrum ([`Fft2::compact_len`]: the
+    /// `N` non-zero values of each column). A [`Fft2::column_pass`] zero-pads
+    /// and transforms one column at a time ([`Columns::forward`]), so a caller
     /// can process a column while it is in cache (the spectral products
     /// between the forward and inverse column transforms, see `Operator::apply`).
     pub fn forward_rows_padded(&mut self, input: &[f64], out: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.row_stage(input, self.n, self.n, out);
+        self.row_stage(input, self.n, self.n, out, self.n);
     }
 
     /// Calls `f(kx, a_kx, b_kx, columns)` for every column `kx` of two
-    /// spectra `a` and `b` (`M` values each) and stores its value in
-    /// `values[kx]`; the columns are shared out among the threads, each with
-    /// its own [`Columns`]. `b` may be a spectrum `f` does not touch.
+    /// compact spectra `a` and `b` (see [`Fft2::compact_len`]) and stores its
+    /// value in `values[kx]`; the columns are shared out among the threads,
+    /// each with its own [`Columns`]. `f` sees whole columns (`M` values, the
+    /// compact column's `N` then whatever the last column left: the forward
+    /// transform zero-pads); with `keep`, their first `N` values are stored
+    /// back (for [`Fft2::inverse_rows_cropped`]). With `two` false, `f`
+    /// leaves its second column alone and `b` is not read or written.
+    ///
+    /// (The full-height work spectra this replaces were 268 MB of the peak
+    /// of a coupled 2048² solve; the column copies cost no measurable time.)
     pub fn column_pass<F>(
         &mut self,
-        a: &mut [Complex64],
-        b: &mut [Complex64],
+        (a, b): (&mut [Complex64], &mut [Complex64]),
+        (two, keep): (bool, bool),
         values: &mut [f64],
         f: F,
     ) where
@@ -300,43 +319,52 @@ impl Fft2 {
     {
         let m = self.m;
         let h = m / 2 + 1;
-        debug_assert_eq!(a.len(), m * h);
-        debug_assert_eq!(b.len(), m * h);
+        let n = self.n;
+        debug_assert_eq!(a.len(), n * h);
+        debug_assert_eq!(b.len(), n * h);
         debug_assert_eq!(values.len(), h);
-        let (n, fwd, inv) = (self.n, &*self.col_fwd, &*self.col_inv);
-        let Some(pool) = self.threads.pool() else {
+        let (fwd, inv) = (&*self.col_fwd, &*self.col_inv);
+        // Columns `first..` of (a, b) through `f`, with one task's buffers.
+        let run = |first: usize,
+                   a: &mut [Complex64],
+                   b: &mut [Complex64],
+                   vals: &mut [f64],
+                   bufs: &mut TaskBufs| {
+            let [ca, cb] = &mut bufs.columns;
             let mut cols = Columns {
                 n,
                 fwd,
                 inv,
-                scratch: &mut self.tasks[0].scratch,
+                scratch: &mut bufs.scratch,
             };
-            let pairs = a.chunks_exact_mut(m).zip(b.chunks_exact_mut(m));
-            for (kx, ((ca, cb), v)) in pairs.zip(values.iter_mut()).enumerate() {
-                *v = f(kx, ca, cb, &mut cols);
+            let pairs = a.chunks_exact_mut(n).zip(b.chunks_exact_mut(n));
+            for (k, ((sa, sb), v)) in pairs.zip(vals.iter_mut()).enumerate() {
+                ca[..n].copy_from_slice(sa);
+                if two {
+                    cb[..n].copy_from_slice(sb);
+                }
+                *v = f(first + k, ca, cb, &mut cols);
+                if keep {
+                    sa.copy_from_slice(&ca[..n]);
+                    if two {
+                        sb.copy_from_slice(&cb[..n]);
+                    }
+                }
             }
+        };
+        let Some(pool) = self.threads.pool() else {
+            run(0, a, b, values, &mut self.tasks[0]);
             return;
         };
         let per = h.div_ceil(self.tasks.len());
         let parts = a
-            .par_chunks_mut(per * m)
-            .zip(b.par_chunks_mut(per * m))
+            .par_chunks_mut(per * n)
+            .zip(b.par_chunks_mut(per * n))
             .zip(values.par_chunks_mut(per))
             .zip(self.tasks.par_iter_mut())
             .enumerate();
         pool.install(|| {
-            parts.for_each(|(t, (((a, b), vals), bufs))| {
-                let mut cols = Columns {
-                    n,
-                    fwd,
-                    inv,
-                    scratch: &mut bufs.scratch,
-                };
-                let pairs = a.chunks_exact_mut(m).zip(b.chunks_exact_mut(m));
-                for (k, ((ca, cb), v)) in pairs.zip(vals.iter_mut()).enumerate() {
-                    *v = f(t * per + k, ca, cb, &mut cols);
-                }
-            })
+            parts.for_each(|(t, (((a, b), vals), bufs))| run(t * per, a, b, vals, bufs))
         });
     }
 
@@ -345,13 +373,13 @@ impl Fft2 {
     /// through [`Columns::inverse`].
     pub fn inverse_rows_cropped(&mut self, spec: &[Complex64], out: &mut [f64], add: bool) {
         let _span = timing::Span::new();
-        self.inverse_row_stage(spec, self.n, self.n, out, add);
+        self.inverse_row_stage(spec, self.n, self.n, out, add, self.n);
     }
 
     fn forward_rows(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
         let m = self.m;
         let h = m / 2 + 1;
-        self.row_stage(input, nrows, ncols, out);
+        self.row_stage(input, nrows, ncols, out, m);
         // Zero padding rows.
         for kx in 0..h {
             out[kx * m + nrows..(kx + 1) * m].fill(Complex64::default());
@@ -378,14 +406,25 @@ impl Fft2 {
         });
     }
 
-    fn row_stage(&mut self, input: &[f64], nrows: usize, ncols: usize, out: &mut [Complex64]) {
+    /// The row transforms of `nrows` rows of `input` into a transposed
+    /// spectrum whose columns hold `stride` values (`M`, or `N` compact).
+    fn row_stage(
+        &mut self,
+        input: &[f64],
+        nrows: usize,
+        ncols: usize,
+        out: &mut [Complex64],
+        stride: usize,
+    ) {
         let m = self.m;
         debug_assert_eq!(input.len(), nrows * ncols);
-        debug_assert_eq!(out.len(), m * (m / 2 + 1));
+        debug_assert_eq!(out.len(), stride * (m / 2 + 1));
+        debug_assert!(nrows <= stride);
         let r2c = &*self.r2c;
         let out = Scatter::new(out);
+        let at = Layout { m, stride };
         let Some(pool) = self.threads.pool() else {
-            row_tiles(r2c, &mut self.tasks[0], input, ncols, 0..nrows, m, out);
+            row_tiles(r2c, &mut self.tasks[0], input, ncols, 0..nrows, at, out);
             return;
         };
         // Whole tiles per task, so the tasks' rows are disjoint.
@@ -394,7 +433,7 @@ impl Fft2 {
         pool.install(|| {
             parts.for_each(|(t, bufs)| {
                 let rows = (t * per).min(nrows)..((t + 1) * per).min(nrows);
-                row_tiles(r2c, bufs, input, ncols, rows, m, out);
+                row_tiles(r2c, bufs, input, ncols, rows, at, out);
             })
         });
     }
@@ -433,7 +472,7 @@ impl Fft2 {
         let threads = self.threads.clone();
         threads.install(|| {
             self.whole_columns(spec, false);
-            self.inverse_row_stage(spec, self.n, self.n, out, false);
+            self.inverse_row_stage(spec, self.n, self.n, out, false, self.m);
         });
     }
 
@@ -443,7 +482,7 @@ impl Fft2 {
         let threads = self.threads.clone();
         threads.install(|| {
             self.whole_columns(spec, false);
-            self.inverse_row_stage(spec, self.n, self.n, out, true);
+            self.inverse_row_stage(spec, self.n, self.n, out, true, self.m);
         });
     }
 
@@ -454,10 +493,12 @@ impl Fft2 {
         let threads = self.threads.clone();
         threads.install(|| {
             self.whole_columns(spec, false);
-            self.inverse_row_stage(spec, self.m, self.m, out, false);
+            self.inverse_row_stage(spec, self.m, self.m, out, false, self.m);
         });
     }
 
+    /// The inverse row transforms of the first `n` rows of a transposed
+    /// spectrum whose columns hold `stride` values (`M`, or `N` compact).
     fn inverse_row_stage(
         &mut self,
         spec: &[Complex64],
@@ -465,13 +506,16 @@ impl Fft2 {
         ncols: usize,
         out: &mut [f64],
         add: bool,
+        stride: usize,
     ) {
         let m = self.m;
-        debug_assert_eq!(spec.len(), m * (m / 2 + 1));
+        debug_assert_eq!(spec.len(), stride * (m / 2 + 1));
         debug_assert_eq!(out.len(), n * ncols);
+        debug_assert!(n <= stride);
         let c2r = &*self.c2r;
+        let at = Layout { m, stride };
         let Some(pool) = self.threads.pool() else {
-            inverse_tiles(c2r, &mut self.tasks[0], spec, 0, ncols, m, out, add);
+            inverse_tiles(c2r, &mut self.tasks[0], spec, 0, ncols, at, out, add);
             return;
         };
         // Whole tiles per task: each task owns its rows of `out`.
@@ -482,23 +526,31 @@ impl Fft2 {
             .enumerate();
         pool.install(|| {
             parts.for_each(|(t, (rows, bufs))| {
-                inverse_tiles(c2r, bufs, spec, t * per, ncols, m, rows, add);
+                inverse_tiles(c2r, bufs, spec, t * per, ncols, at, rows, add);
             })
         });
     }
 }
 
+/// The padded side `M` and the values held per column of a transposed
+/// spectrum (`M` for a whole spectrum, `N` for a compact one).
+#[derive(Clone, Copy)]
+struct Layout {
+    m: usize,
+    stride: usize,
+}
+
 /// Row transforms of rows `rows` of `input` (`ncols` values each, zero
 /// padded to `M`), a tile at a time, each tile moved into its place in the
-/// transposed spectrum `out` (`[kx][ky]`). Writes only `out[kx * M + iy]` for
-/// `iy` in `rows`.
+/// transposed spectrum `out` (`[kx][ky]`). Writes only
+/// `out[kx * stride + iy]` for `iy` in `rows`.
 fn row_tiles(
     r2c: &dyn RealToComplex<f64>,
     bufs: &mut TaskBufs,
     input: &[f64],
     ncols: usize,
     rows: std::ops::Range<usize>,
-    m: usize,
+    Layout { m, stride }: Layout,
     out: Scatter,
 ) {
     let h = m / 2 + 1;
@@ -514,7 +566,7 @@ fn row_tiles(
         for kx in 0..h {
             for (r, iy) in (iy0..iy1).enumerate() {
                 // SAFETY: row `iy` belongs to this task's `rows` only.
-                unsafe { out.write(kx * m + iy, bufs.tile[r * h + kx]) };
+                unsafe { out.write(kx * stride + iy, bufs.tile[r * h + kx]) };
             }
         }
     }
@@ -530,7 +582,7 @@ fn inverse_tiles(
     spec: &[Complex64],
     first: usize,
     ncols: usize,
-    m: usize,
+    Layout { m, stride }: Layout,
     out: &mut [f64],
     add: bool,
 ) {
@@ -542,7 +594,7 @@ fn inverse_tiles(
         let r1 = (r0 + TILE).min(nrows);
         let (iy0, iy1) = (first + r0, first + r1);
         for kx in 0..h {
-            let col = &spec[kx * m + iy0..kx * m + iy1];
+            let col = &spec[kx * stride + iy0..kx * stride + iy1];
             for (r, c) in col.iter().enumerate() {
                 bufs.tile[r * h + kx] = *c;
             }

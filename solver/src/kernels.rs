@@ -13,7 +13,9 @@ use crate::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
 use crate::operator::{Operator, Spectra};
 use crate::parallel::Threads;
 use crate::spec::CaseSpec;
-use crate::tangential::{solve_tangential, TangentialProblem, TangentialSolution};
+use crate::tangential::{
+    solve_tangential, solve_tangential_taking, TangentialProblem, TangentialSolution,
+};
 use crate::window::WindowCache;
 
 /// Identity of a kernel: material name and constants, cells per side and
@@ -134,6 +136,16 @@ impl Resident {
         prob: &TangentialProblem,
     ) -> Result<TangentialSolution, SolverError> {
         solve_tangential(&mut self.operator, &mut self.windows, prob)
+    }
+
+    /// [`solve_tangential`] on this bundle from the tractions `start`, which
+    /// the solver takes over as work space (`prob.start` is not read).
+    pub(crate) fn solve_tangential_from(
+        &mut self,
+        prob: &TangentialProblem,
+        start: (Vec<f64>, Vec<f64>),
+    ) -> Result<TangentialSolution, SolverError> {
+        solve_tangential_taking(&mut self.operator, &mut self.windows, prob, Some(start))
     }
 }
 

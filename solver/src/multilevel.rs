@@ -25,7 +25,6 @@ pub struct FourierPrecond {
     fft: Fft2,
     symbol: Vec<f64>,
     spec: Vec<Complex64>,
-    field: Vec<f64>,
 }
 
 impl FourierPrecond {
@@ -48,12 +47,10 @@ impl FourierPrecond {
             }
         }
         symbol[0] = 0.0;
-        let spec = vec![Complex64::default(); fft.spectrum_len()];
         FourierPrecond {
             fft,
             symbol,
-            spec,
-            field: vec![0.0; n * n],
+            spec: Vec::new(),
         }
     }
 
@@ -63,30 +60,47 @@ impl FourierPrecond {
     }
 
     /// `z = Π W Π g` over the cells where `active` is true (`z` is zero elsewhere).
+    /// (`z` holds the intermediate fields: no field-sized buffer of its own.)
     pub fn apply(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
-        centre_on(active, g, &mut self.field);
-        self.fft.forward_padded(&self.field, &mut self.spec);
+        ensure_len(&mut self.spec, self.fft.spectrum_len());
+        z.copy_from_slice(g);
+        centre_on(active, z);
+        self.fft.forward_padded(z, &mut self.spec);
         for (v, w) in self.spec.iter_mut().zip(&self.symbol) {
             *v *= *w;
         }
         self.fft.inverse_cropped(&mut self.spec, z);
-        self.field.copy_from_slice(z);
-        centre_on(active, &self.field, z);
+        centre_on(active, z);
     }
 }
 
-/// `Π`: `dst = src − mean_active(src)` on the active cells, zero elsewhere.
-fn centre_on(active: &[bool], src: &[f64], dst: &mut [f64]) {
+impl FourierPrecond {
+    /// Frees the work spectrum until the next application: a normal solve
+    /// holds it, the rest of a case does not (see [`crate::normal::NormalCache`]).
+    pub fn release_work(&mut self) {
+        self.spec = Vec::new();
+    }
+}
+
+/// `v` resized to `len` zeros if it is not that long (a released work buffer).
+fn ensure_len(v: &mut Vec<Complex64>, len: usize) {
+    if v.len() != len {
+        *v = vec![Complex64::default(); len];
+    }
+}
+
+/// `Π` in place: `v − mean_active(v)` on the active cells, zero elsewhere.
+fn centre_on(active: &[bool], v: &mut [f64]) {
     let (mut s, mut c) = (0.0, 0usize);
-    for (v, &a) in src.iter().zip(active) {
+    for (x, &a) in v.iter().zip(active) {
         if a {
-            s += v;
+            s += x;
             c += 1;
         }
     }
     let mean = if c > 0 { s / c as f64 } else { 0.0 };
-    for ((d, v), &a) in dst.iter_mut().zip(src).zip(active) {
-        *d = if a { v - mean } else { 0.0 };
+    for (x, &a) in v.iter_mut().zip(active) {
+        *x = if a { *x - mean } else { 0.0 };
     }
 }
 
@@ -99,6 +113,7 @@ pub struct CoarseLevel {
     fft: Fft2,
     /// Real spectrum of the (even) coarse `K_zz`.
     zz: Vec<f64>,
+    /// Work spectrum (empty between nested starts).
     spec: Vec<Complex64>,
     precond: FourierPrecond,
 }
@@ -111,11 +126,18 @@ impl CoarseLevel {
 
     /// `uz = K_zz * p` on this level.
     pub fn normal(&mut self, p: &[f64], uz: &mut [f64]) {
+        ensure_len(&mut self.spec, self.fft.spectrum_len());
         self.fft.forward_padded(p, &mut self.spec);
         for (s, k) in self.spec.iter_mut().zip(&self.zz) {
             *s *= k;
         }
         self.fft.inverse_cropped(&mut self.spec, uz);
+    }
+
+    /// Frees this level's work spectra until its next use (a nested start).
+    pub fn release_work(&mut self) {
+        self.spec = Vec::new();
+        self.precond.release_work();
     }
 
     /// Runs this level's transforms on `threads` (results unchanged).
@@ -176,7 +198,7 @@ pub fn coarse_levels(grid: Grid, zz_table: &[f64]) -> Vec<CoarseLevel> {
             grid: g,
             fft,
             zz,
-            spec,
+            spec: Vec::new(),
             precond: FourierPrecond::new(g),
         });
     }

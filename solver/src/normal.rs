@@ -489,8 +489,11 @@ pub fn solve_normal(
                         tolerance: coarse_tol,
                         ..fine
                     };
-                    let rep = polonsky_keer(level, &coarse, &mut pl, &mut ul)?;
-                    coarse_iterations += rep.iterations;
+                    let rep = polonsky_keer(level, &coarse, &mut pl, &mut ul);
+                    // Levels are used once per nested start: no work
+                    // spectra are kept between starts.
+                    level.release_work();
+                    coarse_iterations += rep?.iterations;
                     let mut up = prolong(&pl, g.n);
                     up.iter_mut().for_each(|v| *v = v.max(0.0));
                     start = Some(up);
@@ -504,7 +507,13 @@ pub fn solve_normal(
         op: &mut *op,
         precond: &mut cache.precond,
     };
-    let mut report = polonsky_keer(&mut fine_op, &fine, &mut p, &mut u)?;
+    let report = polonsky_keer(&mut fine_op, &fine, &mut p, &mut u);
+    // The preconditioner's work spectrum is not held between normal solves
+    // (through the tangential solves, where a coupled case peaks).
+    if let Some(pre) = &mut cache.precond {
+        pre.release_work();
+    }
+    let mut report = report?;
     report.coarse_iterations = coarse_iterations;
     // Final state and residuals from the returned pressure.
     op.normal(&p, &mut u);

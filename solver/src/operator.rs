@@ -194,8 +194,8 @@ pub struct Operator {
     grid: Grid,
     fft: Fft2,
     spectra: Spectra,
-    /// Two work spectra: the sources of an apply round, overwritten in place
-    /// by the destinations' spectra.
+    /// Two compact work spectra ([`Fft2::compact_len`]): the sources of an
+    /// apply round, overwritten in place by the destinations' spectra.
     work: [Vec<Complex64>; 2],
     /// One value per column of a column pass (the energy product's terms).
     column_values: Vec<f64>,
@@ -383,13 +383,12 @@ impl Operator {
     /// An operator from its parts; work spectra and the tangential bound
     /// follow from them.
     fn with_fft(grid: Grid, fft: Fft2, spectra: Spectra) -> Self {
-        let slen = fft.spectrum_len();
         Operator {
             grid,
             tangential_bound: tangential_symbol_max(&spectra),
             tangential_self: tangential_self(&spectra, fft.padded_len()),
             spectra,
-            work: std::array::from_fn(|_| vec![Complex64::default(); slen]),
+            work: std::array::from_fn(|_| vec![Complex64::default(); fft.compact_len()]),
             column_values: vec![0.0; fft.padded_len() / 2 + 1],
             fft,
         }
@@ -490,6 +489,24 @@ impl Operator {
         Self::with_fft(grid, fft, Spectra::from_stored(out))
     }
 
+    /// Frees the two work spectra until the next application (which makes
+    /// them again): for operators used in bursts, such as the coarse levels
+    /// of a coarse-to-fine start (at 2048², 34 MB held between cases by the
+    /// whole grid's tangential levels alone).
+    pub fn release_work(&mut self) {
+        self.work = Default::default();
+    }
+
+    /// The work spectra, made again if [`Operator::release_work`] freed them.
+    fn ensure_work(&mut self) {
+        let len = self.fft.compact_len();
+        for w in &mut self.work {
+            if w.len() != len {
+                *w = vec![Complex64::default(); len];
+            }
+        }
+    }
+
     /// Runs the transforms and spectral products on `threads` from now on
     /// (the results do not change, see [`crate::parallel`]); window
     /// operators made later inherit them.
@@ -545,6 +562,7 @@ impl Operator {
         dst: &mut [(usize, &mut [f64])],
         add: bool,
     ) {
+        self.ensure_work();
         let [w0, w1] = &mut self.work;
         for ((_, t), w) in src.iter().zip([&mut *w0, &mut *w1]) {
             self.fft.forward_rows_padded(t, w);
@@ -557,8 +575,12 @@ impl Operator {
         }
         let m = self.fft.padded_len();
         let (ns, nd) = (src.len(), dst.len());
-        self.fft
-            .column_pass(w0, w1, &mut self.column_values, |kx, c0, c1, cols| {
+        let two = ns > 1 || nd > 1;
+        self.fft.column_pass(
+            (w0, w1),
+            (two, true),
+            &mut self.column_values,
+            |kx, c0, c1, cols| {
                 cols.forward(c0);
                 if ns > 1 {
                     cols.forward(c1);
@@ -574,7 +596,8 @@ impl Operator {
                     cols.inverse(c1);
                 }
                 0.0
-            });
+            },
+        );
         for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
             self.fft.inverse_rows_cropped(w, u, add);
         }
@@ -592,6 +615,7 @@ impl Operator {
 
     /// The stages of [`Operator::tangential_energy`].
     fn energy_stages(&mut self, tx: &[f64], ty: &[f64]) -> f64 {
+        self.ensure_work();
         let [w0, w1] = &mut self.work;
         self.fft.forward_rows_padded(tx, w0);
         self.fft.forward_rows_padded(ty, w1);
@@ -602,8 +626,11 @@ impl Operator {
             &self.spectra.off[0],
         );
         // Each column's term on the threads, their sum in column order here.
-        self.fft
-            .column_pass(w0, w1, &mut self.column_values, |kx, c0, c1, cols| {
+        self.fft.column_pass(
+            (w0, w1),
+            (true, false),
+            &mut self.column_values,
+            |kx, c0, c1, cols| {
                 let col = kx * m..(kx + 1) * m;
                 cols.forward(c0);
                 cols.forward(c1);
@@ -611,7 +638,8 @@ impl Operator {
                 let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
                 let _span = crate::fft2::timing::Span::product();
                 weight * energy_column(c0, c1, &kxx[col.clone()], &kyy[col.clone()], &kxy[col])
-            });
+            },
+        );
         let mut sum = 0.0;
         for v in &self.column_values {
             sum += v;

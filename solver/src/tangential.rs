@@ -132,12 +132,23 @@ fn slip_field(
 struct Feasible<'a> {
     /// The contact cells.
     cells: &'a [usize],
-    /// Friction bound b_i = μ p_i per cell, Pa.
-    bound: &'a [f64],
+    /// Pressure per cell, Pa: the friction bound is [`Feasible::bound`].
+    p: &'a [f64],
+    /// Friction coefficient.
+    mu: f64,
     /// Σ b_i over `cells` (fixed for a solve, so it is summed once).
     cap: f64,
     /// Σ q_i required: the force over the cell area, Pa.
     target: [f64; 2],
+}
+
+impl Feasible<'_> {
+    /// Friction bound b_i = μ p_i of cell `i`, Pa (computed where it is
+    /// used: a stored field of them was 34 MB of a 2048² solve's peak).
+    #[inline]
+    fn bound(&self, i: usize) -> f64 {
+        self.mu * self.p[i].max(0.0)
+    }
 }
 
 /// Exact projection of `z` onto the feasible set: q_i = Π_i(z_i + λ).
@@ -149,10 +160,7 @@ fn project(
     (qx, qy): (&mut [f64], &mut [f64]),
 ) -> Option<()> {
     let Feasible {
-        cells,
-        bound,
-        cap,
-        target,
+        cells, cap, target, ..
     } = *set;
     let tnorm = target[0].hypot(target[1]);
     if tnorm >= cap {
@@ -166,7 +174,7 @@ fn project(
         for &i in cells {
             let (wx, wy) = (zx[i] + l[0], zy[i] + l[1]);
             let w = norm(wx, wy);
-            let b = bound[i];
+            let b = set.bound(i);
             if w <= b {
                 qx[i] = wx;
                 qy[i] = wy;
@@ -239,28 +247,41 @@ pub fn solve_tangential(
     windows: &mut WindowCache,
     prob: &TangentialProblem,
 ) -> Result<TangentialSolution, SolverError> {
+    solve_tangential_taking(op, windows, prob, None)
+}
+
+/// Start tractions `(qx, qy)` handed over to a solve, which keeps them as
+/// its work fields instead of copying them (two fields fewer at its peak:
+/// 67 MB of a coupled 2048² solve). Given, they replace
+/// [`TangentialProblem::start`].
+pub(crate) type Handed = Option<(Vec<f64>, Vec<f64>)>;
+
+/// [`solve_tangential`], from the tractions `handed` when given.
+pub(crate) fn solve_tangential_taking(
+    op: &mut Operator,
+    windows: &mut WindowCache,
+    prob: &TangentialProblem,
+    handed: Handed,
+) -> Result<TangentialSolution, SolverError> {
     let n = op.grid().n;
     let Some(win) = contact_window(n, prob.p) else {
         let levels = windows.grid_levels(op);
-        return solve_nested(op, levels, prob);
+        return solve_nested_taking(op, levels, prob, handed);
     };
     let p = win.gather(prob.p);
     let extra = prob.extra.map(|(ex, ey)| (win.gather(ex), win.gather(ey)));
-    let q_init = match prob.start {
-        TangentialStart::Tractions(qx, qy) => Some((win.gather(qx), win.gather(qy))),
-        TangentialStart::Proportional => None,
+    let q_init = match (handed, prob.start) {
+        (Some((qx, qy)), _) => Some((win.gather(&qx), win.gather(&qy))),
+        (None, TangentialStart::Tractions(qx, qy)) => Some((win.gather(qx), win.gather(qy))),
+        (None, TangentialStart::Proportional) => None,
     };
     let sub = TangentialProblem {
         p: &p,
         extra: extra.as_ref().map(|(x, y)| (&x[..], &y[..])),
-        start: match &q_init {
-            Some((x, y)) => TangentialStart::Tractions(x, y),
-            None => TangentialStart::Proportional,
-        },
         ..*prob
     };
     let (wop, levels) = windows.operator_and_levels(op, win.n);
-    let sol = solve_nested(wop, levels, &sub)?;
+    let sol = solve_nested_taking(wop, levels, &sub, q_init)?;
     Ok(TangentialSolution {
         qx: win.scatter(&sol.qx, 0.0),
         qy: win.scatter(&sol.qy, 0.0),
@@ -281,19 +302,23 @@ pub fn solve_nested(
     levels: &mut TangentialLevels,
     prob: &TangentialProblem,
 ) -> Result<TangentialSolution, SolverError> {
-    if !matches!(prob.start, TangentialStart::Proportional) {
-        return solve_tangential_on_grid(op, prob);
+    solve_nested_taking(op, levels, prob, None)
+}
+
+/// [`solve_nested`], from the tractions `handed` when given.
+fn solve_nested_taking(
+    op: &mut Operator,
+    levels: &mut TangentialLevels,
+    prob: &TangentialProblem,
+    handed: Handed,
+) -> Result<TangentialSolution, SolverError> {
+    if handed.is_some() || !matches!(prob.start, TangentialStart::Proportional) {
+        return on_grid_taking(op, prob, handed);
     }
     let Some((qx, qy, coarse)) = coarse_start(levels, prob)? else {
-        return solve_tangential_on_grid(op, prob);
+        return on_grid_taking(op, prob, None);
     };
-    let mut sol = solve_tangential_on_grid(
-        op,
-        &TangentialProblem {
-            start: TangentialStart::Tractions(&qx, &qy),
-            ..*prob
-        },
-    )?;
+    let mut sol = on_grid_taking(op, prob, Some((qx, qy)))?;
     sol.report.coarse_iterations = coarse;
     Ok(sol)
 }
@@ -304,15 +329,26 @@ pub fn solve_tangential_on_grid(
     op: &mut Operator,
     prob: &TangentialProblem,
 ) -> Result<TangentialSolution, SolverError> {
+    on_grid_taking(op, prob, None)
+}
+
+/// [`solve_tangential_on_grid`], from the tractions `handed` when given.
+fn on_grid_taking(
+    op: &mut Operator,
+    prob: &TangentialProblem,
+    handed: Handed,
+) -> Result<TangentialSolution, SolverError> {
     let grid = op.grid();
     let len = grid.len();
     let da = grid.cell_area();
     let p = prob.p;
     let mu = prob.friction;
-    let cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
-    let bound: Vec<f64> = p.iter().map(|&v| mu * v.max(0.0)).collect();
+    let mut cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
+    // Collected by doubling: up to twice the contact's cells (4 MB at 1024²).
+    cells.shrink_to_fit();
     // Σ b_i over the contact cells: the largest force the discs can carry.
-    let cap: f64 = cells.iter().map(|&i| bound[i]).sum();
+    let bound = |i: usize| mu * p[i].max(0.0);
+    let cap: f64 = cells.iter().map(|&i| bound(i)).sum();
     let normal: f64 = p.iter().sum::<f64>() * da;
     let fnorm = prob.force[0].hypot(prob.force[1]);
     if fnorm >= mu * normal {
@@ -326,24 +362,37 @@ pub fn solve_tangential_on_grid(
     let target = [prob.force[0] / da, prob.force[1] / da];
     let set = Feasible {
         cells: &cells,
-        bound: &bound,
+        p,
+        mu,
         cap,
         target,
     };
     let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
-    let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
-    match prob.start {
-        TangentialStart::Tractions(ix, iy) => {
-            zx.copy_from_slice(ix);
-            zy.copy_from_slice(iy);
+    let (mut zx, mut zy) = match handed {
+        Some((zx, zy)) => {
+            assert!(
+                zx.len() == len && zy.len() == len,
+                "start tractions off the grid"
+            );
+            (zx, zy)
         }
-        TangentialStart::Proportional => {
-            for &i in &cells {
-                zx[i] = prob.force[0] / normal * p[i];
-                zy[i] = prob.force[1] / normal * p[i];
+        None => {
+            let (mut zx, mut zy) = (vec![0.0; len], vec![0.0; len]);
+            match prob.start {
+                TangentialStart::Tractions(ix, iy) => {
+                    zx.copy_from_slice(ix);
+                    zy.copy_from_slice(iy);
+                }
+                TangentialStart::Proportional => {
+                    for &i in &cells {
+                        zx[i] = prob.force[0] / normal * p[i];
+                        zy[i] = prob.force[1] / normal * p[i];
+                    }
+                }
             }
+            (zx, zy)
         }
-    }
+    };
     for i in 0..len {
         if p[i] <= 0.0 {
             zx[i] = 0.0;
@@ -456,7 +505,7 @@ pub fn solve_tangential_on_grid(
     }
     let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
     for &i in &cells {
-        stick[i] = qx[i].hypot(qy[i]) < stick_tol * bound[i];
+        stick[i] = qx[i].hypot(qy[i]) < stick_tol * bound(i);
         if stick[i] {
             mx += sx[i];
             my += sy[i];
@@ -569,7 +618,8 @@ fn cg_disc(
     (zx, zy): (&mut [f64], &mut [f64]),
     lambda: &mut [f64; 2],
 ) -> Result<CgOutcome, SolverError> {
-    let Feasible { cells, bound, .. } = *set;
+    let cells = set.cells;
+    let bound = |i: usize| set.bound(i);
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
     // The cells' elastic stiffness in the preconditioner, m/Pa: a cell's own
@@ -582,7 +632,7 @@ fn cg_disc(
     // Stick set of the current tractions: here, then after each projection.
     let mut stick = vec![false; len];
     for &i in cells {
-        stick[i] = !on_bound(qx[i], qy[i], bound[i]);
+        stick[i] = !on_bound(qx[i], qy[i], bound(i));
     }
     // This iteration's `SlipCell` of each slip cell, in the order of `cells`
     // (the later passes of an iteration walk `cells` in the same order).
@@ -633,7 +683,7 @@ fn cg_disc(
             let qn = norm(qx[i], qy[i]);
             let n = [qx[i] / qn, qy[i] / qn];
             let press = -((ux[i] - d[0]) * n[0] + (uy[i] - d[1]) * n[1]);
-            let c = press.max(0.0) / bound[i];
+            let c = press.max(0.0) / bound(i);
             let k = if c > STIFF_RIM * stiffness {
                 0.0
             } else {
@@ -812,7 +862,7 @@ fn cg_disc(
         // the move.
         let mut released = false;
         for &i in cells {
-            let sticks = !on_bound(qx[i], qy[i], bound[i]);
+            let sticks = !on_bound(qx[i], qy[i], bound(i));
             released |= sticks && !stick[i];
             stick[i] = sticks;
             dqx[i] = qx[i] - dqx[i];
