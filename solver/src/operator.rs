@@ -441,13 +441,14 @@ impl Operator {
         Self::with_fft(grid, fft, spectra)
     }
 
-    /// The operator of an `nw x nw` window of this grid (same cells, `nw ≤ N`):
-    /// the same influence coefficients for offsets below `nw` cells, on the
-    /// smaller `2nw x 2nw` wrap-around grid, taken from this operator's
-    /// spectra by one inverse transform per stored component (no
-    /// re-integration). Fields that vanish outside a window (tractions on the
-    /// contact cells) are applied exactly by it, and its transforms cost
-    /// `(nw/N)²` of this grid's.
+    /// The tangential block (xx, yy, xy) of the operator of an `nw x nw`
+    /// window of this grid (same cells, `nw ≤ N`): the same influence
+    /// coefficients for offsets below `nw` cells, on the smaller `2nw x 2nw`
+    /// wrap-around grid, taken from this operator's spectra by one inverse
+    /// transform per component (no re-integration). Tractions that vanish
+    /// outside the window (on the contact cells) are applied exactly by it,
+    /// and its transforms cost `(nw/N)²` of this grid's. Like the coarse
+    /// tangential levels, it has no normal components.
     pub fn window_operator(&mut self, nw: usize) -> Operator {
         assert!(
             nw >= 1 && nw <= self.grid.n,
@@ -466,8 +467,12 @@ impl Operator {
         let mut table = vec![0.0; m * m];
         let mut row = vec![0.0; mw];
         let source = |i: usize| if i < nw { i } else { i + m - mw };
-        let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(STORED.len());
-        for &(i, j) in &STORED {
+        // Only the tangential block: a window operator applies tractions
+        // (the tangential solver's; the coupling terms come from the whole
+        // grid's operator), and the other three components were 56 % of its
+        // bytes.
+        let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(3);
+        for (i, j) in [(X, X), (Y, Y), (X, Y)] {
             crate::progress::tick();
             self.spectra.component(i, j).write_complex(&mut spec);
             self.fft.inverse_full(&mut spec, &mut table);
@@ -486,7 +491,13 @@ impl Operator {
             out.push(w);
         }
         drop((spec, table));
-        Self::with_fft(grid, fft, Spectra::from_stored(out))
+        let [xx, yy, xy]: [Vec<Complex64>; 3] = out.try_into().expect("three components");
+        let re = |s: Vec<Complex64>| s.iter().map(|z| z.re).collect::<Vec<f64>>();
+        let spectra = Spectra {
+            diag: [re(xx), re(yy), Vec::new()],
+            off: [xy, Vec::new(), Vec::new()],
+        };
+        Self::with_fft(grid, fft, spectra)
     }
 
     /// Frees the two work spectra until the next application (which makes
