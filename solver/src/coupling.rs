@@ -190,18 +190,8 @@ pub(crate) fn solve_step(
     let fnorm = force[0].hypot(force[1]);
     let previous = step.previous.as_ref();
 
-    let mut tan = TangentialSolution {
-        qx: vec![0.0; len],
-        qy: vec![0.0; len],
-        sx: vec![0.0; len],
-        sy: vec![0.0; len],
-        stick: p.iter().map(|&v| v > 0.0).collect(),
-        shift: [0.0; 2],
-        report: TangentialReport {
-            converged: true,
-            ..Default::default()
-        },
-    };
+    // The last pass's tangential solution (none before the first pass).
+    let mut last: Option<TangentialSolution> = None;
     let mut tangential_iterations = 0;
     let mut coupling_iterations = 0;
     let mut coupling_change = 0.0;
@@ -219,7 +209,6 @@ pub(crate) fn solve_step(
         };
         let has_extra = num.coupling || previous.is_some();
         coupling_converged = !num.coupling;
-        let mut have_q = false;
         // Inexact inner solves while the coupling loop is far from converged:
         // each inner tolerance follows the last change of p, and the final
         // passes use the configured tolerances.
@@ -269,8 +258,6 @@ pub(crate) fn solve_step(
                     ey[i] -= prev.u.1[i];
                 }
             }
-            // The initial (zero) slip is not an input: free it meanwhile.
-            drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
             let prob = TangentialProblem {
                 p: &p,
                 friction: spec.load.friction,
@@ -285,22 +272,22 @@ pub(crate) fn solve_step(
             };
             // From the second pass on, the last pass's tractions start the
             // solve, which takes them over (they are replaced by its own).
-            let sol = if have_q {
-                let start = (std::mem::take(&mut tan.qx), std::mem::take(&mut tan.qy));
-                res.solve_tangential_from(&prob, start)?
-            } else {
-                res.solve_tangential(&prob)?
+            let mut tan = match last.take() {
+                Some(prev) => res.solve_tangential_from(&prob, (prev.qx, prev.qy))?,
+                None => res.solve_tangential(&prob)?,
             };
-            have_q = true;
-            tangential_iterations += sol.report.iterations;
-            tan = sol;
+            tangential_iterations += tan.report.iterations;
             if !num.coupling || coupling_converged {
+                last = Some(tan);
                 break;
             }
-            // Another tangential solve follows this pass: its slip, and the
-            // slip terms, are not needed again.
             drop((ex, ey));
-            drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
+            // When another tangential solve follows this pass, its slip is
+            // not needed again; after the last pass the budget allows, it is
+            // the slip the case reports.
+            if k < num.max_coupling_iterations {
+                drop((std::mem::take(&mut tan.sx), std::mem::take(&mut tan.sy)));
+            }
             let mut hq = vec![0.0; len];
             res.operator
                 .apply(&[(X, &tan.qx), (Y, &tan.qy)], &mut [(Z, &mut hq)]);
@@ -329,6 +316,7 @@ pub(crate) fn solve_step(
                 * da
                 / load;
             rescale_slip(&mut tan, &p, &nsol.p, spec.load.friction, force);
+            last = Some(tan);
             p = nsol.p;
             approach = nsol.approach;
             // One more tangential solve at the updated pressure closes the loop.
@@ -338,10 +326,23 @@ pub(crate) fn solve_step(
             prev_change = coupling_change;
         }
     }
+    // Without a tangential force: no tractions, every contact cell sticks.
+    let tangential = last.unwrap_or_else(|| TangentialSolution {
+        qx: vec![0.0; len],
+        qy: vec![0.0; len],
+        sx: vec![0.0; len],
+        sy: vec![0.0; len],
+        stick: p.iter().map(|&v| v > 0.0).collect(),
+        shift: [0.0; 2],
+        report: TangentialReport {
+            converged: true,
+            ..Default::default()
+        },
+    });
     Ok(ContactState {
         p,
         approach,
-        tangential: tan,
+        tangential,
         normal_report,
         normal_iterations,
         tangential_iterations,

@@ -303,3 +303,34 @@ fn an_unconverged_solve_is_flagged_not_called_unresolved() {
         "{s:?}"
     );
 }
+
+/// A coupled solve stopped by its pass budget reports the slip of its last
+/// tangential solve on every cell of the grid: zero on the stick cells and,
+/// on the slip cells still in contact, opposed to the traction (the
+/// friction law; the last normal solve may have moved the contact's edge).
+#[test]
+fn a_solve_stopped_by_its_coupling_budget_keeps_its_slip_field() {
+    for passes in [1, 2] {
+        let mut spec = table_1c("Ni", "flat", 32, 200.0, 0.0);
+        spec.numerics.coupling = true;
+        spec.numerics.max_coupling_iterations = passes;
+        let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
+        let (s, f) = (&out.scalars, &out.fields);
+        assert!(!s.converged && s.coupling_iterations == passes, "{s:?}");
+        let len = f.n * f.n;
+        assert_eq!((f.sx.len(), f.sy.len()), (len, len), "{passes} passes");
+        let mut slipping = 0;
+        for i in 0..len {
+            let slip = f.sx[i].hypot(f.sy[i]);
+            if f.stick[i] == 1.0 {
+                assert_eq!(slip, 0.0, "stick cell {i}");
+            } else if slip > 1e-3 * s.delta_t_m.abs() && f.p[i] > 0.0 {
+                slipping += 1;
+                let q = f.qx[i].hypot(f.qy[i]);
+                let cos = (f.sx[i] * f.qx[i] + f.sy[i] * f.qy[i]) / (slip * q);
+                assert!(cos < -0.99, "cell {i}: slip at cos {cos} to the traction");
+            }
+        }
+        assert!(slipping > 0, "{passes} passes: no slip zone");
+    }
+}
