@@ -164,6 +164,15 @@ impl Columns<'_> {
     }
 }
 
+/// `v` made `len` zeros if it is not that long: a work spectrum that was
+/// released between uses (`Operator::release_work`) is made again on its
+/// next use.
+pub(crate) fn ensure_len(v: &mut Vec<Complex64>, len: usize) {
+    if v.len() != len {
+        *v = vec![Complex64::default(); len];
+    }
+}
+
 /// FFT plans and scratch for one padded grid size. Build once, apply many times.
 ///
 /// The row and column stages run on the threads set by

@@ -11,7 +11,7 @@
 //! coarse levels only ever provide initial guesses: every result is converged on
 //! the fine grid.
 
-use crate::fft2::Fft2;
+use crate::fft2::{ensure_len, Fft2};
 use crate::grid::Grid;
 use crate::parallel::Threads;
 use num_complex::Complex64;
@@ -72,20 +72,11 @@ impl FourierPrecond {
         self.fft.inverse_cropped(&mut self.spec, z);
         centre_on(active, z);
     }
-}
 
-impl FourierPrecond {
     /// Frees the work spectrum until the next application: a normal solve
     /// holds it, the rest of a case does not (see [`crate::normal::NormalCache`]).
     pub fn release_work(&mut self) {
         self.spec = Vec::new();
-    }
-}
-
-/// `v` resized to `len` zeros if it is not that long (a released work buffer).
-fn ensure_len(v: &mut Vec<Complex64>, len: usize) {
-    if v.len() != len {
-        *v = vec![Complex64::default(); len];
     }
 }
 

@@ -55,6 +55,17 @@ impl Spectra {
         Spectra { diag, off }
     }
 
+    /// The tangential block only, from the complex spectra of `K_xx`, `K_yy`
+    /// (kept as their real parts) and `K_xy`: what the operators of windows
+    /// and coarse tangential levels hold.
+    fn tangential(xx: Vec<Complex64>, yy: Vec<Complex64>, xy: Vec<Complex64>) -> Spectra {
+        let re = |s: Vec<Complex64>| s.iter().map(|z| z.re).collect::<Vec<f64>>();
+        Spectra {
+            diag: [re(xx), re(yy), Vec::new()],
+            off: [xy, Vec::new(), Vec::new()],
+        }
+    }
+
     fn component(&self, i: usize, j: usize) -> Kr<'_> {
         match (i, j) {
             _ if i == j => Kr::Re(&self.diag[i]),
@@ -432,12 +443,7 @@ impl Operator {
             fft.forward_full(t, &mut s);
             s
         };
-        let re = |s: Vec<Complex64>| s.iter().map(|z| z.re).collect::<Vec<f64>>();
-        let (sxx, syy, sxy) = (re(spec(xx)), re(spec(yy)), spec(xy));
-        let spectra = Spectra {
-            diag: [sxx, syy, Vec::new()],
-            off: [sxy, Vec::new(), Vec::new()],
-        };
+        let spectra = Spectra::tangential(spec(xx), spec(yy), spec(xy));
         Self::with_fft(grid, fft, spectra)
     }
 
@@ -471,8 +477,7 @@ impl Operator {
         // (the tangential solver's; the coupling terms come from the whole
         // grid's operator), and the other three components were 56 % of its
         // bytes.
-        let mut out: Vec<Vec<Complex64>> = Vec::with_capacity(3);
-        for (i, j) in [(X, X), (Y, Y), (X, Y)] {
+        let [xx, yy, xy] = [(X, X), (Y, Y), (X, Y)].map(|(i, j)| {
             crate::progress::tick();
             self.spectra.component(i, j).write_complex(&mut spec);
             self.fft.inverse_full(&mut spec, &mut table);
@@ -488,16 +493,10 @@ impl Operator {
                 fft.forward_row_into(iy, &row, &mut w);
             }
             fft.forward_columns(&mut w);
-            out.push(w);
-        }
+            w
+        });
         drop((spec, table));
-        let [xx, yy, xy]: [Vec<Complex64>; 3] = out.try_into().expect("three components");
-        let re = |s: Vec<Complex64>| s.iter().map(|z| z.re).collect::<Vec<f64>>();
-        let spectra = Spectra {
-            diag: [re(xx), re(yy), Vec::new()],
-            off: [xy, Vec::new(), Vec::new()],
-        };
-        Self::with_fft(grid, fft, spectra)
+        Self::with_fft(grid, fft, Spectra::tangential(xx, yy, xy))
     }
 
     /// Frees the two work spectra until the next application (which makes
@@ -512,9 +511,7 @@ impl Operator {
     fn ensure_work(&mut self) {
         let len = self.fft.compact_len();
         for w in &mut self.work {
-            if w.len() != len {
-                *w = vec![Complex64::default(); len];
-            }
+            crate::fft2::ensure_len(w, len);
         }
     }
 

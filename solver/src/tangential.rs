@@ -142,7 +142,21 @@ struct Feasible<'a> {
     target: [f64; 2],
 }
 
-impl Feasible<'_> {
+impl<'a> Feasible<'a> {
+    /// The set of the contact cells `cells` of the pressure `p`.
+    fn new(cells: &'a [usize], p: &'a [f64], mu: f64, target: [f64; 2]) -> Self {
+        let mut set = Feasible {
+            cells,
+            p,
+            mu,
+            cap: 0.0,
+            target,
+        };
+        // Σ b_i over the contact cells: the largest force the discs can carry.
+        set.cap = cells.iter().map(|&i| set.bound(i)).sum();
+        set
+    }
+
     /// Friction bound b_i = μ p_i of cell `i`, Pa (computed where it is
     /// used: a stored field of them was 34 MB of a 2048² solve's peak).
     #[inline]
@@ -346,9 +360,6 @@ fn on_grid_taking(
     let mut cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
     // Collected by doubling: up to twice the contact's cells (4 MB at 1024²).
     cells.shrink_to_fit();
-    // Σ b_i over the contact cells: the largest force the discs can carry.
-    let bound = |i: usize| mu * p[i].max(0.0);
-    let cap: f64 = cells.iter().map(|&i| bound(i)).sum();
     let normal: f64 = p.iter().sum::<f64>() * da;
     let fnorm = prob.force[0].hypot(prob.force[1]);
     if fnorm >= mu * normal {
@@ -360,13 +371,7 @@ fn on_grid_taking(
         });
     }
     let target = [prob.force[0] / da, prob.force[1] / da];
-    let set = Feasible {
-        cells: &cells,
-        p,
-        mu,
-        cap,
-        target,
-    };
+    let set = Feasible::new(&cells, p, mu, target);
     let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
     let (mut zx, mut zy) = match handed {
         Some((zx, zy)) => {
@@ -505,7 +510,7 @@ fn on_grid_taking(
     }
     let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
     for &i in &cells {
-        stick[i] = qx[i].hypot(qy[i]) < stick_tol * bound(i);
+        stick[i] = qx[i].hypot(qy[i]) < stick_tol * set.bound(i);
         if stick[i] {
             mx += sx[i];
             my += sy[i];
