@@ -6,6 +6,16 @@
 //! so the column transforms run on contiguous memory. Forward transforms may
 //! assume that only the first `N` rows and columns of the input are non-zero
 //! (zero padding), and inverse transforms only produce the first `N` rows.
+//!
+//! Split columns: a column of the padded grid is `N` values and `N` zeros,
+//! so its length-`2N` transform is two length-`N` transforms (of the values,
+//! and of the values times `e^{−2πi n/2N}`), and its inverse, of which only
+//! the first `N` values are kept, two length-`N` inverse transforms combined
+//! with the same factors. For the sides in [`SPLIT_SIDES`] a column pass
+//! ([`Fft2::column_pass`]) transforms its columns so and holds them in
+//! *split order*: the even frequencies `ky = 2j` at `j`, the odd ones
+//! `ky = 2j + 1` at `N + j` ([`Fft2::to_split_order`]); for other sides in
+//! natural order, with one length-`2N` transform.
 
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -92,7 +102,22 @@ pub mod timing {
 
 /// Rows transformed together and moved to (from) the transposed spectrum as
 /// one tile: the tile (`TILE x (M/2 + 1)` complex values) stays in cache.
-const TILE: usize = 16;
+///
+/// (64 rows: the row stage of a 2048² field took 7.6 instead of 8.7 ns per
+/// cell, that of a 512² field 5.0 instead of 5.5; `cargo run --release -p
+/// mpcontact-solver --example fft_stages`.)
+const TILE: usize = 64;
+
+/// Grid sides `N` whose column passes run split columns (module docs): the
+/// sides where that was measured faster. rustfft's length-4096 plan stands
+/// out on the development machine, at 0.33–0.35 ns per value and radix-2
+/// level against 0.27 for 2048 and 0.31 for 8192: a forward and inverse
+/// column took 25–26 µs split against 29–38 µs whole at `N = 2048`, but
+/// 4.6–6.9 against 4.3 at 512, 11.1 against 10.2–10.7 at 1024 and 68–83
+/// against 56–57 at 4096 (the factors cost a pass each way); see
+/// docs/performance.md. Only results on these sides differ, at round-off,
+/// from whole-column transforms.
+const SPLIT_SIDES: [usize; 1] = [2048];
 
 /// The buffers of one task of a row or column stage.
 struct TaskBufs {
@@ -142,25 +167,50 @@ impl Scatter {
 /// column (see [`Fft2::column_pass`]) transforms its columns with.
 pub struct Columns<'a> {
     n: usize,
+    /// Length `N` for split columns, else `M`.
     fwd: &'a dyn Fft<f64>,
     inv: &'a dyn Fft<f64>,
+    /// `e^{−2πi n/M}` for `n < N` for split columns, else empty.
+    twiddles: &'a [Complex64],
     scratch: &'a mut [Complex64],
 }
 
 impl Columns<'_> {
-    /// Column `kx` (`M` values) of a spectrum after
-    /// [`Fft2::forward_rows_padded`]: zero padding, then the forward column transform.
+    /// Column `kx` of a spectrum after [`Fft2::forward_rows_padded`] (its
+    /// `N` values first, the other `M − N` are ignored): the forward column
+    /// transform of the zero-padded column (in split order for split
+    /// columns, module docs).
     pub fn forward(&mut self, col: &mut [Complex64]) {
         let _span = timing::Span::new();
-        col[self.n..].fill(Complex64::default());
-        self.fwd.process_with_scratch(col, self.scratch);
+        if self.twiddles.is_empty() {
+            col[self.n..].fill(Complex64::default());
+            self.fwd.process_with_scratch(col, self.scratch);
+            return;
+        }
+        let (lo, hi) = col.split_at_mut(self.n);
+        for ((h, l), t) in hi.iter_mut().zip(lo.iter()).zip(self.twiddles) {
+            *h = l * t;
+        }
+        self.fwd.process_with_scratch(lo, self.scratch);
+        self.fwd.process_with_scratch(hi, self.scratch);
     }
 
-    /// Inverse column transform of one column (`M` values) of a spectrum;
+    /// Inverse column transform of one column (`M` values, in the order
+    /// [`Columns::forward`] leaves) of a spectrum: its first `N` values (the
+    /// others are left undefined for split columns);
     /// [`Fft2::inverse_rows_cropped`] completes the inverse transform.
     pub fn inverse(&mut self, col: &mut [Complex64]) {
         let _span = timing::Span::new();
-        self.inv.process_with_scratch(col, self.scratch);
+        if self.twiddles.is_empty() {
+            self.inv.process_with_scratch(col, self.scratch);
+            return;
+        }
+        let (lo, hi) = col.split_at_mut(self.n);
+        self.inv.process_with_scratch(lo, self.scratch);
+        self.inv.process_with_scratch(hi, self.scratch);
+        for ((l, h), t) in lo.iter_mut().zip(hi.iter()).zip(self.twiddles) {
+            *l += h * t.conj();
+        }
     }
 }
 
@@ -186,6 +236,11 @@ pub struct Fft2 {
     c2r: Arc<dyn ComplexToReal<f64>>,
     col_fwd: Arc<dyn Fft<f64>>,
     col_inv: Arc<dyn Fft<f64>>,
+    /// Length-`N` plans of a column pass's split columns (module docs),
+    /// when this grid's side is in [`SPLIT_SIDES`].
+    split: Option<[Arc<dyn Fft<f64>>; 2]>,
+    /// `e^{−2πi n/M}` for `n < N` with split columns, else empty.
+    twiddles: Vec<Complex64>,
     threads: Threads,
     /// One per task ([`Threads`]`::tasks`); the serial stages use the first.
     tasks: Vec<TaskBufs>,
@@ -195,12 +250,17 @@ pub struct Fft2 {
 impl Fft2 {
     /// Plans for an `n x n` physical grid padded to `2n x 2n`.
     pub fn new(n: usize) -> Self {
-        Self::with_sizes(n, 2 * n)
+        Self::padded_with_split(n, SPLIT_SIDES.contains(&n))
+    }
+
+    /// [`Fft2::new`] with split columns (module docs) or not, whatever the side.
+    pub(crate) fn padded_with_split(n: usize, split: bool) -> Self {
+        Self::with_sizes(n, 2 * n, split)
     }
 
     /// Plans for an `n x n` field on an unpadded periodic `n x n` grid.
     pub fn periodic(n: usize) -> Self {
-        Self::with_sizes(n, n)
+        Self::with_sizes(n, n, false)
     }
 
     /// The padded-grid side (`2n`, or `n` for a periodic transform).
@@ -208,13 +268,23 @@ impl Fft2 {
         self.m
     }
 
-    fn with_sizes(n: usize, m: usize) -> Self {
+    fn with_sizes(n: usize, m: usize, split: bool) -> Self {
         let mut rp = RealFftPlanner::<f64>::new();
         let r2c = rp.plan_fft_forward(m);
         let c2r = rp.plan_fft_inverse(m);
         let mut cp = FftPlanner::<f64>::new();
         let col_fwd = cp.plan_fft_forward(m);
         let col_inv = cp.plan_fft_inverse(m);
+        let split = (split && m == 2 * n).then(|| [cp.plan_fft_forward(n), cp.plan_fft_inverse(n)]);
+        let twiddles = match split {
+            Some(_) => (0..n)
+                .map(|k| {
+                    let (sin, cos) = (-2.0 * std::f64::consts::PI * k as f64 / m as f64).sin_cos();
+                    Complex64::new(cos, sin)
+                })
+                .collect(),
+            None => Vec::new(),
+        };
         let scratch_len = [
             r2c.get_scratch_len(),
             c2r.get_scratch_len(),
@@ -222,6 +292,7 @@ impl Fft2 {
             col_inv.get_inplace_scratch_len(),
         ]
         .into_iter()
+        .chain(split.iter().flatten().map(|p| p.get_inplace_scratch_len()))
         .max()
         .unwrap_or(0)
         .max(1);
@@ -232,6 +303,8 @@ impl Fft2 {
             c2r,
             col_fwd,
             col_inv,
+            split,
+            twiddles,
             threads: Threads::serial(),
             tasks: Vec::new(),
             scratch_len,
@@ -311,9 +384,11 @@ impl Fft2 {
     /// value in `values[kx]`; the columns are shared out among the threads,
     /// each with its own [`Columns`]. `f` sees whole columns (`M` values, the
     /// compact column's `N` then whatever the last column left: the forward
-    /// transform zero-pads); with `keep`, their first `N` values are stored
+    /// transform reads only the first `N`, and its result is in split order,
+    /// see the module docs); with `keep`, their first `N` values are stored
     /// back (for [`Fft2::inverse_rows_cropped`]). With `two` false, `f`
     /// leaves its second column alone and `b` is not read or written.
+    /// Padded grids only (`M = 2N`).
     ///
     /// (The full-height work spectra this replaces were 268 MB of the peak
     /// of a coupled 2048² solve. The column copies did not show in the
@@ -331,10 +406,15 @@ impl Fft2 {
         let m = self.m;
         let h = m / 2 + 1;
         let n = self.n;
+        assert_eq!(m, 2 * n, "a column pass needs a padded grid");
         debug_assert_eq!(a.len(), n * h);
         debug_assert_eq!(b.len(), n * h);
         debug_assert_eq!(values.len(), h);
-        let (fwd, inv) = (&*self.col_fwd, &*self.col_inv);
+        let (fwd, inv) = match &self.split {
+            Some([f, i]) => (&**f, &**i),
+            None => (&*self.col_fwd, &*self.col_inv),
+        };
+        let twiddles = &self.twiddles[..];
         // Columns `first..` of (a, b) through `f`, with one task's buffers.
         let run = |first: usize,
                    a: &mut [Complex64],
@@ -346,6 +426,7 @@ impl Fft2 {
                 n,
                 fwd,
                 inv,
+                twiddles,
                 scratch: &mut bufs.scratch,
             };
             let pairs = a.chunks_exact_mut(n).zip(b.chunks_exact_mut(n));
@@ -377,6 +458,42 @@ impl Fft2 {
         pool.install(|| {
             parts.for_each(|(t, (((a, b), vals), bufs))| run(t * per, a, b, vals, bufs))
         });
+    }
+
+    /// Puts every column (`M` values) of a spectrum in natural order
+    /// (`[kx][ky]`, as [`Fft2::forward_full`] makes it) into the order of a
+    /// column pass: split order for split columns (module docs), else
+    /// unchanged. What a kernel spectrum multiplied in a column pass is
+    /// stored in.
+    pub fn to_split_order<T: Copy + Default>(&self, spec: &mut [T]) {
+        if self.split.is_none() {
+            return;
+        }
+        let (m, n) = (self.m, self.n);
+        let mut tmp = vec![T::default(); m];
+        for col in spec.chunks_exact_mut(m) {
+            for j in 0..n {
+                tmp[j] = col[2 * j];
+                tmp[n + j] = col[2 * j + 1];
+            }
+            col.copy_from_slice(&tmp);
+        }
+    }
+
+    /// The inverse of [`Fft2::to_split_order`].
+    pub fn to_natural_order<T: Copy + Default>(&self, spec: &mut [T]) {
+        if self.split.is_none() {
+            return;
+        }
+        let (m, n) = (self.m, self.n);
+        let mut tmp = vec![T::default(); m];
+        for col in spec.chunks_exact_mut(m) {
+            for j in 0..n {
+                tmp[2 * j] = col[j];
+                tmp[2 * j + 1] = col[n + j];
+            }
+            col.copy_from_slice(&tmp);
+        }
     }
 
     /// Inverse row stage of [`Fft2::inverse_cropped`] (`add`: of
@@ -632,6 +749,68 @@ fn inverse_tiles(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A column pass with split columns and a kernel spectrum in split
+    /// order gives the convolution of whole columns, to round-off, for even
+    /// and odd sides; the orders are inverse permutations.
+    #[test]
+    fn split_columns_give_the_whole_columns_convolution() {
+        for n in [8, 24, 33] {
+            let m = 2 * n;
+            let h = m / 2 + 1;
+            let wave = |len: usize, a: f64| -> Vec<f64> {
+                (0..len)
+                    .map(|i| (i as f64 * a).sin() + 0.3 * (i as f64 * 0.11).cos())
+                    .collect()
+            };
+            let (fa, fb) = (wave(n * n, 0.37), wave(n * n, 0.73));
+            let mut kernel = vec![Complex64::default(); m * h];
+            Fft2::new(n).forward_full(&wave(m * m, 0.19), &mut kernel);
+            let convolve = |split: bool| -> Vec<f64> {
+                let mut fft = Fft2::padded_with_split(n, split);
+                let mut k = kernel.clone();
+                fft.to_split_order(&mut k);
+                if split {
+                    assert_ne!(k, kernel);
+                    let mut back = k.clone();
+                    fft.to_natural_order(&mut back);
+                    assert_eq!(back, kernel);
+                }
+                let mut a = vec![Complex64::default(); fft.compact_len()];
+                let mut b = a.clone();
+                fft.forward_rows_padded(&fa, &mut a);
+                fft.forward_rows_padded(&fb, &mut b);
+                let mut values = vec![0.0; h];
+                fft.column_pass(
+                    (&mut a, &mut b),
+                    (true, true),
+                    &mut values,
+                    |kx, c0, c1, cols| {
+                        cols.forward(c0);
+                        cols.forward(c1);
+                        let kc = &k[kx * m..(kx + 1) * m];
+                        for ((x, y), k) in c0.iter_mut().zip(c1.iter_mut()).zip(kc) {
+                            (*x, *y) = (*x * k + *y, *y * k.conj());
+                        }
+                        cols.inverse(c0);
+                        cols.inverse(c1);
+                        0.0
+                    },
+                );
+                let mut out = vec![0.0; 2 * n * n];
+                let (o0, o1) = out.split_at_mut(n * n);
+                fft.inverse_rows_cropped(&a, o0, false);
+                fft.inverse_rows_cropped(&b, o1, false);
+                out
+            };
+            let (whole, split) = (convolve(false), convolve(true));
+            let scale = whole.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+            assert!(scale > 1.0);
+            for (w, s) in whole.iter().zip(&split) {
+                assert!((w - s).abs() < 1e-13 * scale, "n = {n}: {w} vs {s}");
+            }
+        }
+    }
 
     #[test]
     fn timing_counts_transforms_only_while_on() {

@@ -196,6 +196,25 @@ fn energy_column(a: &[Complex64], b: &[Complex64], d0: &[f64], d1: &[f64], c: &[
     acc.iter().sum::<f64>() + tail
 }
 
+/// Every stored component of `s` put into the split order of a column pass
+/// (`to_split`) or back into natural order.
+fn split_order(fft: &Fft2, s: &mut Spectra, to_split: bool) {
+    for d in &mut s.diag {
+        if to_split {
+            fft.to_split_order(d);
+        } else {
+            fft.to_natural_order(d);
+        }
+    }
+    for o in &mut s.off {
+        if to_split {
+            fft.to_split_order(o);
+        } else {
+            fft.to_natural_order(o);
+        }
+    }
+}
+
 /// The `(i, j)` components stored, in the order of a build: diagonal, then
 /// `xy`, `xz`, `yz`.
 const STORED: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
@@ -393,16 +412,29 @@ impl Operator {
 
     /// An operator from its parts; work spectra and the tangential bound
     /// follow from them.
-    fn with_fft(grid: Grid, fft: Fft2, spectra: Spectra) -> Self {
+    fn with_fft(grid: Grid, fft: Fft2, mut spectra: Spectra) -> Self {
+        let tangential_bound = tangential_symbol_max(&spectra);
+        let tangential_self = tangential_self(&spectra, fft.padded_len());
+        split_order(&fft, &mut spectra, true);
         Operator {
             grid,
-            tangential_bound: tangential_symbol_max(&spectra),
-            tangential_self: tangential_self(&spectra, fft.padded_len()),
+            tangential_bound,
+            tangential_self,
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); fft.compact_len()]),
             column_values: vec![0.0; fft.padded_len() / 2 + 1],
             fft,
         }
+    }
+
+    /// This operator on transforms with split columns or not (see
+    /// [`crate::fft2`]), whatever the grid's side: for tests of both paths.
+    #[cfg(test)]
+    fn with_split_columns(mut self, split: bool) -> Self {
+        let spectra = self.with_spectra(Spectra::clone);
+        let mut fft = Fft2::padded_with_split(self.grid.n, split);
+        fft.set_threads(self.fft.threads());
+        Self::with_fft(self.grid, fft, spectra)
     }
 
     /// The real `K_zz` table on the `2N x 2N` wrap-around grid (layout of
@@ -411,6 +443,7 @@ impl Operator {
     pub fn zz_table(&mut self) -> Vec<f64> {
         let mut zz = vec![Complex64::default(); self.fft.spectrum_len()];
         self.spectra.component(Z, Z).write_complex(&mut zz);
+        self.fft.to_natural_order(&mut zz);
         let m = self.fft.padded_len();
         let mut table = vec![0.0; m * m];
         self.fft.inverse_full(&mut zz, &mut table);
@@ -423,6 +456,7 @@ impl Operator {
     pub fn table(&mut self, i: usize, j: usize) -> Vec<f64> {
         let mut spec = vec![Complex64::default(); self.fft.spectrum_len()];
         self.spectra.component(i, j).write_complex(&mut spec);
+        self.fft.to_natural_order(&mut spec);
         let m = self.fft.padded_len();
         let mut table = vec![0.0; m * m];
         self.fft.inverse_full(&mut spec, &mut table);
@@ -480,6 +514,7 @@ impl Operator {
         let [xx, yy, xy] = [(X, X), (Y, Y), (X, Y)].map(|(i, j)| {
             crate::progress::tick();
             self.spectra.component(i, j).write_complex(&mut spec);
+            self.fft.to_natural_order(&mut spec);
             self.fft.inverse_full(&mut spec, &mut table);
             let mut w = vec![Complex64::default(); fft.spectrum_len()];
             for iy in 0..mw {
@@ -527,9 +562,15 @@ impl Operator {
         self.fft.threads()
     }
 
-    /// The kernel spectra held (what a kernel store persists).
-    pub fn spectra(&self) -> &Spectra {
-        &self.spectra
+    /// `f` of the kernel spectra held, in natural order (what a kernel
+    /// store persists; the operator holds them in the split order of its
+    /// column passes, see [`crate::fft2`], and puts them back in place
+    /// around the call instead of copying them).
+    pub fn with_spectra<R>(&mut self, f: impl FnOnce(&Spectra) -> R) -> R {
+        split_order(&self.fft, &mut self.spectra, false);
+        let r = f(&self.spectra);
+        split_order(&self.fft, &mut self.spectra, true);
+        r
     }
 
     /// The grid this operator was built for.
@@ -825,31 +866,67 @@ mod tests {
     fn row_by_row_build_equals_the_table_build() {
         let grid = grid(10, 20e-6, 20e-6);
         let cell = cu111_cell(grid);
-        let a = Operator::build(grid, &cell);
-        let b = Operator::from_tables(grid, &Operator::tables(grid, &cell));
-        let scale = a.spectra().diag[Z]
-            .iter()
-            .fold(0.0_f64, |m, v| m.max(v.abs()));
-        for (x, y) in a.spectra().diag.iter().zip(&b.spectra().diag) {
+        let a = Operator::build(grid, &cell).with_spectra(Spectra::clone);
+        let b = Operator::from_tables(grid, &Operator::tables(grid, &cell))
+            .with_spectra(Spectra::clone);
+        let scale = a.diag[Z].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (x, y) in a.diag.iter().zip(&b.diag) {
             for (u, v) in x.iter().zip(y) {
                 assert!((u - v).abs() < 1e-13 * scale);
             }
         }
-        for (x, y) in a.spectra().off.iter().zip(&b.spectra().off) {
+        for (x, y) in a.off.iter().zip(&b.off) {
             for (u, v) in x.iter().zip(y) {
                 assert!((u - v).norm() < 1e-13 * scale);
             }
         }
-        assert_eq!(a.spectra().bytes(), 9 * Spectra::len_for(grid.n) * 8);
+        assert_eq!(a.bytes(), 9 * Spectra::len_for(grid.n) * 8);
     }
 
     #[test]
     fn anisotropic_apply_equals_direct_summation_on_every_path() {
+        for split in [false, true] {
+            apply_equals_direct_summation_on_every_path(split);
+        }
+    }
+
+    /// Split columns (`crate::fft2`) keep the kernel spectra in split order;
+    /// the tables and window operators made from them are those of whole
+    /// columns, to round-off.
+    #[test]
+    fn split_columns_give_the_same_tables_and_windows() {
+        let grid = grid(12, 20e-6, 25e-6);
+        let cell = cu111_cell(grid);
+        let mut whole = Operator::build(grid, &cell).with_split_columns(false);
+        let mut split = Operator::build(grid, &cell).with_split_columns(true);
+        let close = |a: &[f64], b: &[f64]| {
+            let scale = max_abs(a);
+            assert!(scale > 0.0);
+            for (x, y) in a.iter().zip(b) {
+                assert!((x - y).abs() < 1e-13 * scale, "{x:e} vs {y:e}");
+            }
+        };
+        close(&whole.zz_table(), &split.zz_table());
+        close(&whole.table(X, Y), &split.table(X, Y));
+        assert_eq!(
+            whole.with_spectra(Spectra::clone),
+            split.with_spectra(Spectra::clone)
+        );
+        let t = [pseudo_random(64, 3), pseudo_random(64, 4)];
+        let mut u = [vec![0.0; 64], vec![0.0; 64], vec![0.0; 64], vec![0.0; 64]];
+        let [a, b, c, d] = &mut u;
+        whole.window_operator(8).tangential(&t[0], &t[1], a, b);
+        split.window_operator(8).tangential(&t[0], &t[1], c, d);
+        close(a, c);
+        close(b, d);
+    }
+
+    fn apply_equals_direct_summation_on_every_path(split: bool) {
         // The reciprocal storage (K_yx from K_xy etc.) and each apply path
         // (1, 2 or 3 sources; 1, 2 or 3 destinations) against direct sums.
         let grid = grid(12, 20e-6, 25e-6);
         let cell = cu111_cell(grid);
-        let mut op = Operator::build(grid, &cell);
+        let mut op = Operator::build(grid, &cell).with_split_columns(split);
         let n = grid.n;
         let t: Vec<Vec<f64>> = (0..3)
             .map(|c| pseudo_random(n * n, 11 + c as u64))
