@@ -101,12 +101,20 @@ pub mod timing {
 }
 
 /// Rows transformed together and moved to (from) the transposed spectrum as
-/// one tile: the tile (`TILE x (M/2 + 1)` complex values) stays in cache.
+/// one tile (`tile_rows(M) x (M/2 + 1)` complex values, kept in cache): 64
+/// rows from `M = 2048` on, 16 below.
 ///
 /// (64 rows: the row stage of a 2048² field took 7.6 instead of 8.7 ns per
 /// cell, that of a 512² field 5.0 instead of 5.5; `cargo run --release -p
-/// mpcontact-solver --example fft_stages`.)
-const TILE: usize = 64;
+/// mpcontact-solver --example fft_stages`. Each `Fft2` keeps its tiles, and
+/// at 512² the larger ones added 3 MB, 2.5 %, to a coupled solve's peak.)
+fn tile_rows(m: usize) -> usize {
+    if m >= 2048 {
+        64
+    } else {
+        16
+    }
+}
 
 /// Grid sides `N` whose column passes run split columns (module docs): the
 /// sides where that was measured faster. rustfft's length-4096 plan stands
@@ -122,7 +130,7 @@ const SPLIT_SIDES: [usize; 1] = [2048];
 /// The buffers of one task of a row or column stage.
 struct TaskBufs {
     row_real: Vec<f64>,
-    /// `TILE` row spectra, `[row][kx]`.
+    /// `tile_rows(M)` row spectra, `[row][kx]`.
     tile: Vec<Complex64>,
     scratch: Vec<Complex64>,
     /// Two whole columns (`M` values each) of a [`Fft2::column_pass`].
@@ -317,7 +325,7 @@ impl Fft2 {
         let h = self.m / 2 + 1;
         TaskBufs {
             row_real: vec![0.0; self.m],
-            tile: vec![Complex64::default(); TILE.min(self.m) * h],
+            tile: vec![Complex64::default(); tile_rows(self.m).min(self.m) * h],
             scratch: vec![Complex64::default(); self.scratch_len],
             columns: std::array::from_fn(|_| vec![Complex64::default(); self.m]),
         }
@@ -556,7 +564,8 @@ impl Fft2 {
             return;
         };
         // Whole tiles per task, so the tasks' rows are disjoint.
-        let per = nrows.div_ceil(TILE).div_ceil(self.tasks.len()) * TILE;
+        let tile = tile_rows(m);
+        let per = nrows.div_ceil(tile).div_ceil(self.tasks.len()) * tile;
         let parts = self.tasks.par_iter_mut().enumerate();
         pool.install(|| {
             parts.for_each(|(t, bufs)| {
@@ -647,7 +656,8 @@ impl Fft2 {
             return;
         };
         // Whole tiles per task: each task owns its rows of `out`.
-        let per = n.div_ceil(TILE).div_ceil(self.tasks.len()) * TILE;
+        let tile = tile_rows(m);
+        let per = n.div_ceil(tile).div_ceil(self.tasks.len()) * tile;
         let parts = out
             .par_chunks_mut(per * ncols)
             .zip(self.tasks.par_iter_mut())
@@ -682,8 +692,9 @@ fn row_tiles(
     out: Scatter,
 ) {
     let h = m / 2 + 1;
-    for iy0 in rows.clone().step_by(TILE) {
-        let iy1 = (iy0 + TILE).min(rows.end);
+    let tile = tile_rows(m);
+    for iy0 in rows.clone().step_by(tile) {
+        let iy1 = (iy0 + tile).min(rows.end);
         for (r, iy) in (iy0..iy1).enumerate() {
             bufs.row_real[..ncols].copy_from_slice(&input[iy * ncols..(iy + 1) * ncols]);
             bufs.row_real[ncols..].fill(0.0);
@@ -736,8 +747,9 @@ fn inverse_tiles(
     let scale = 1.0 / (m as f64 * m as f64);
     let nrows = out.len() / ncols;
     // Gather a tile from the transposed spectrum, then inverse row transforms.
-    for r0 in (0..nrows).step_by(TILE) {
-        let r1 = (r0 + TILE).min(nrows);
+    let tile = tile_rows(m);
+    for r0 in (0..nrows).step_by(tile) {
+        let r1 = (r0 + tile).min(nrows);
         let (iy0, iy1) = (first + r0, first + r1);
         for kx in 0..h {
             // The tile's part of column `kx + AHEAD` is asked for now: the
