@@ -921,6 +921,26 @@ mod tests {
         close(b, d);
     }
 
+    /// Split columns run each column the same way on any thread: 1 and 2
+    /// threads give the same bits (solver/tests/threads.rs checks whole
+    /// solves, on grids too small for split columns).
+    #[test]
+    fn split_columns_give_the_same_bits_on_1_and_2_threads() {
+        let grid = grid(12, 20e-6, 25e-6);
+        let cell = cu111_cell(grid);
+        let t = [pseudo_random(144, 5), pseudo_random(144, 6)];
+        let run = |threads: usize| {
+            let mut op = Operator::build(grid, &cell).with_split_columns(true);
+            op.set_threads(&crate::parallel::Threads::new(threads).unwrap());
+            let (mut ux, mut uy) = (vec![0.0; 144], vec![0.0; 144]);
+            op.tangential(&t[0], &t[1], &mut ux, &mut uy);
+            let energy = op.tangential_energy(&t[0], &t[1]);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+            (bits(&ux), bits(&uy), energy.to_bits())
+        };
+        assert_eq!(run(1), run(2));
+    }
+
     fn apply_equals_direct_summation_on_every_path(split: bool) {
         // The reciprocal storage (K_yx from K_xy etc.) and each apply path
         // (1, 2 or 3 sources; 1, 2 or 3 destinations) against direct sums.
