@@ -474,31 +474,30 @@ impl Fft2 {
     /// unchanged. What a kernel spectrum multiplied in a column pass is
     /// stored in.
     pub fn to_split_order<T: Copy + Default>(&self, spec: &mut [T]) {
-        if self.split.is_none() {
-            return;
-        }
-        let (m, n) = (self.m, self.n);
-        let mut tmp = vec![T::default(); m];
-        for col in spec.chunks_exact_mut(m) {
-            for j in 0..n {
-                tmp[j] = col[2 * j];
-                tmp[n + j] = col[2 * j + 1];
-            }
-            col.copy_from_slice(&tmp);
-        }
+        self.reorder_columns(spec, true);
     }
 
     /// The inverse of [`Fft2::to_split_order`].
     pub fn to_natural_order<T: Copy + Default>(&self, spec: &mut [T]) {
+        self.reorder_columns(spec, false);
+    }
+
+    /// Frequency `ky` of a column sits at `split(ky)` in split order; each
+    /// column is moved there (`to_split`) or back.
+    fn reorder_columns<T: Copy + Default>(&self, spec: &mut [T], to_split: bool) {
         if self.split.is_none() {
             return;
         }
         let (m, n) = (self.m, self.n);
+        let split = |ky: usize| ky / 2 + (ky % 2) * n;
         let mut tmp = vec![T::default(); m];
         for col in spec.chunks_exact_mut(m) {
-            for j in 0..n {
-                tmp[2 * j] = col[j];
-                tmp[2 * j + 1] = col[n + j];
+            for (ky, &v) in col.iter().enumerate() {
+                if to_split {
+                    tmp[split(ky)] = v;
+                } else {
+                    tmp[ky] = col[split(ky)];
+                }
             }
             col.copy_from_slice(&tmp);
         }
