@@ -127,6 +127,14 @@ fn tile_rows(m: usize) -> usize {
 /// from whole-column transforms.
 const SPLIT_SIDES: [usize; 1] = [2048];
 
+/// The length-`N` plans and the factors `e^{−2πi n/M}` (`n < N`) of split
+/// columns (module docs).
+struct Split {
+    fwd: Arc<dyn Fft<f64>>,
+    inv: Arc<dyn Fft<f64>>,
+    twiddles: Vec<Complex64>,
+}
+
 /// The buffers of one task of a row or column stage.
 struct TaskBufs {
     row_real: Vec<f64>,
@@ -244,11 +252,10 @@ pub struct Fft2 {
     c2r: Arc<dyn ComplexToReal<f64>>,
     col_fwd: Arc<dyn Fft<f64>>,
     col_inv: Arc<dyn Fft<f64>>,
-    /// Length-`N` plans of a column pass's split columns (module docs),
-    /// when this grid's side is in [`SPLIT_SIDES`].
-    split: Option<[Arc<dyn Fft<f64>>; 2]>,
-    /// `e^{−2πi n/M}` for `n < N` with split columns, else empty.
-    twiddles: Vec<Complex64>,
+    /// A column pass's split columns (module docs), when asked for.
+    split: Option<Split>,
+    /// Rows per tile of the row stages ([`tile_rows`]).
+    tile: usize,
     threads: Threads,
     /// One per task ([`Threads`]`::tasks`); the serial stages use the first.
     tasks: Vec<TaskBufs>,
@@ -283,16 +290,15 @@ impl Fft2 {
         let mut cp = FftPlanner::<f64>::new();
         let col_fwd = cp.plan_fft_forward(m);
         let col_inv = cp.plan_fft_inverse(m);
-        let split = (split && m == 2 * n).then(|| [cp.plan_fft_forward(n), cp.plan_fft_inverse(n)]);
-        let twiddles = match split {
-            Some(_) => (0..n)
+        let split = split.then(|| Split {
+            fwd: cp.plan_fft_forward(n),
+            inv: cp.plan_fft_inverse(n),
+            twiddles: (0..n)
                 .map(|k| {
-                    let (sin, cos) = (-2.0 * std::f64::consts::PI * k as f64 / m as f64).sin_cos();
-                    Complex64::new(cos, sin)
+                    Complex64::from_polar(1.0, -2.0 * std::f64::consts::PI * k as f64 / m as f64)
                 })
                 .collect(),
-            None => Vec::new(),
-        };
+        });
         let scratch_len = [
             r2c.get_scratch_len(),
             c2r.get_scratch_len(),
@@ -300,7 +306,12 @@ impl Fft2 {
             col_inv.get_inplace_scratch_len(),
         ]
         .into_iter()
-        .chain(split.iter().flatten().map(|p| p.get_inplace_scratch_len()))
+        .chain(split.iter().flat_map(|s| {
+            [
+                s.fwd.get_inplace_scratch_len(),
+                s.inv.get_inplace_scratch_len(),
+            ]
+        }))
         .max()
         .unwrap_or(0)
         .max(1);
@@ -312,7 +323,7 @@ impl Fft2 {
             col_fwd,
             col_inv,
             split,
-            twiddles,
+            tile: tile_rows(m),
             threads: Threads::serial(),
             tasks: Vec::new(),
             scratch_len,
@@ -325,7 +336,7 @@ impl Fft2 {
         let h = self.m / 2 + 1;
         TaskBufs {
             row_real: vec![0.0; self.m],
-            tile: vec![Complex64::default(); tile_rows(self.m).min(self.m) * h],
+            tile: vec![Complex64::default(); self.tile.min(self.m) * h],
             scratch: vec![Complex64::default(); self.scratch_len],
             columns: std::array::from_fn(|_| vec![Complex64::default(); self.m]),
         }
@@ -418,11 +429,10 @@ impl Fft2 {
         debug_assert_eq!(a.len(), n * h);
         debug_assert_eq!(b.len(), n * h);
         debug_assert_eq!(values.len(), h);
-        let (fwd, inv) = match &self.split {
-            Some([f, i]) => (&**f, &**i),
-            None => (&*self.col_fwd, &*self.col_inv),
+        let (fwd, inv, twiddles) = match &self.split {
+            Some(s) => (&*s.fwd, &*s.inv, &s.twiddles[..]),
+            None => (&*self.col_fwd, &*self.col_inv, &[][..]),
         };
-        let twiddles = &self.twiddles[..];
         // Columns `first..` of (a, b) through `f`, with one task's buffers.
         let run = |first: usize,
                    a: &mut [Complex64],
@@ -484,7 +494,7 @@ impl Fft2 {
 
     /// Frequency `ky` of a column sits at `split(ky)` in split order; each
     /// column is moved there (`to_split`) or back.
-    fn reorder_columns<T: Copy + Default>(&self, spec: &mut [T], to_split: bool) {
+    pub(crate) fn reorder_columns<T: Copy + Default>(&self, spec: &mut [T], to_split: bool) {
         if self.split.is_none() {
             return;
         }
@@ -557,14 +567,17 @@ impl Fft2 {
         debug_assert!(nrows <= stride);
         let r2c = &*self.r2c;
         let out = Scatter::new(out);
-        let at = Layout { m, stride };
+        let at = Layout {
+            m,
+            stride,
+            tile: self.tile,
+        };
         let Some(pool) = self.threads.pool() else {
             row_tiles(r2c, &mut self.tasks[0], input, ncols, 0..nrows, at, out);
             return;
         };
         // Whole tiles per task, so the tasks' rows are disjoint.
-        let tile = tile_rows(m);
-        let per = nrows.div_ceil(tile).div_ceil(self.tasks.len()) * tile;
+        let per = nrows.div_ceil(self.tile).div_ceil(self.tasks.len()) * self.tile;
         let parts = self.tasks.par_iter_mut().enumerate();
         pool.install(|| {
             parts.for_each(|(t, bufs)| {
@@ -649,14 +662,17 @@ impl Fft2 {
         debug_assert_eq!(out.len(), n * ncols);
         debug_assert!(n <= stride);
         let c2r = &*self.c2r;
-        let at = Layout { m, stride };
+        let at = Layout {
+            m,
+            stride,
+            tile: self.tile,
+        };
         let Some(pool) = self.threads.pool() else {
             inverse_tiles(c2r, &mut self.tasks[0], spec, 0, ncols, at, out, add);
             return;
         };
         // Whole tiles per task: each task owns its rows of `out`.
-        let tile = tile_rows(m);
-        let per = n.div_ceil(tile).div_ceil(self.tasks.len()) * tile;
+        let per = n.div_ceil(self.tile).div_ceil(self.tasks.len()) * self.tile;
         let parts = out
             .par_chunks_mut(per * ncols)
             .zip(self.tasks.par_iter_mut())
@@ -669,12 +685,14 @@ impl Fft2 {
     }
 }
 
-/// The padded side `M` and the values held per column of a transposed
-/// spectrum (`M` for a whole spectrum, `N` for a compact one).
+/// The padded side `M`, the values held per column of a transposed
+/// spectrum (`M` for a whole spectrum, `N` for a compact one) and the rows
+/// per tile.
 #[derive(Clone, Copy)]
 struct Layout {
     m: usize,
     stride: usize,
+    tile: usize,
 }
 
 /// Row transforms of rows `rows` of `input` (`ncols` values each, zero
@@ -687,11 +705,10 @@ fn row_tiles(
     input: &[f64],
     ncols: usize,
     rows: std::ops::Range<usize>,
-    Layout { m, stride }: Layout,
+    Layout { m, stride, tile }: Layout,
     out: Scatter,
 ) {
     let h = m / 2 + 1;
-    let tile = tile_rows(m);
     for iy0 in rows.clone().step_by(tile) {
         let iy1 = (iy0 + tile).min(rows.end);
         for (r, iy) in (iy0..iy1).enumerate() {
@@ -738,7 +755,7 @@ fn inverse_tiles(
     spec: &[Complex64],
     first: usize,
     ncols: usize,
-    Layout { m, stride }: Layout,
+    Layout { m, stride, tile }: Layout,
     out: &mut [f64],
     add: bool,
 ) {
@@ -746,7 +763,6 @@ fn inverse_tiles(
     let scale = 1.0 / (m as f64 * m as f64);
     let nrows = out.len() / ncols;
     // Gather a tile from the transposed spectrum, then inverse row transforms.
-    let tile = tile_rows(m);
     for r0 in (0..nrows).step_by(tile) {
         let r1 = (r0 + tile).min(nrows);
         let (iy0, iy1) = (first + r0, first + r1);

@@ -7,7 +7,7 @@
 
 use crate::error::SolverError;
 use crate::multilevel::{coarse_levels, prolong, restrict, CoarseLevel, FourierPrecond};
-use crate::operator::Operator;
+use crate::operator::{Operator, Z};
 use crate::parallel::Threads;
 
 /// Convergence report of one normal solve.
@@ -95,7 +95,7 @@ impl NormalCache {
     /// The coarse levels below `op`'s grid, from its real `K_zz` table
     /// (held only while they are made).
     pub fn new(op: &mut Operator) -> Self {
-        let table = op.zz_table();
+        let table = op.table(Z, Z);
         let mut cache = NormalCache {
             coarse: coarse_levels(op.grid(), &table),
             precond: None,

@@ -200,18 +200,10 @@ fn energy_column(a: &[Complex64], b: &[Complex64], d0: &[f64], d1: &[f64], c: &[
 /// (`to_split`) or back into natural order.
 fn split_order(fft: &Fft2, s: &mut Spectra, to_split: bool) {
     for d in &mut s.diag {
-        if to_split {
-            fft.to_split_order(d);
-        } else {
-            fft.to_natural_order(d);
-        }
+        fft.reorder_columns(d, to_split);
     }
     for o in &mut s.off {
-        if to_split {
-            fft.to_split_order(o);
-        } else {
-            fft.to_natural_order(o);
-        }
+        fft.reorder_columns(o, to_split);
     }
 }
 
@@ -437,30 +429,23 @@ impl Operator {
         Self::with_fft(self.grid, fft, spectra)
     }
 
-    /// The real `K_zz` table on the `2N x 2N` wrap-around grid (layout of
-    /// [`Operator::tables`]), by one inverse transform of its stored spectrum:
-    /// what the normal solver's Galerkin coarse levels are made from.
-    pub fn zz_table(&mut self) -> Vec<f64> {
-        let mut zz = vec![Complex64::default(); self.fft.spectrum_len()];
-        self.spectra.component(Z, Z).write_complex(&mut zz);
-        self.fft.to_natural_order(&mut zz);
-        let m = self.fft.padded_len();
-        let mut table = vec![0.0; m * m];
-        self.fft.inverse_full(&mut zz, &mut table);
-        table
-    }
-
     /// The real table of component `(i, j)` on the `2N x 2N` wrap-around grid
     /// (layout of [`Operator::tables`]), by one inverse transform of its
     /// stored spectrum: what Galerkin coarse levels are made from.
     pub fn table(&mut self, i: usize, j: usize) -> Vec<f64> {
         let mut spec = vec![Complex64::default(); self.fft.spectrum_len()];
-        self.spectra.component(i, j).write_complex(&mut spec);
-        self.fft.to_natural_order(&mut spec);
         let m = self.fft.padded_len();
         let mut table = vec![0.0; m * m];
-        self.fft.inverse_full(&mut spec, &mut table);
+        self.table_into(i, j, &mut spec, &mut table);
         table
+    }
+
+    /// [`Operator::table`] into `table`, with `spec` (a spectrum's length)
+    /// as scratch; the stored spectrum is put back into natural order first.
+    fn table_into(&mut self, i: usize, j: usize, spec: &mut [Complex64], table: &mut [f64]) {
+        self.spectra.component(i, j).write_complex(spec);
+        self.fft.to_natural_order(spec);
+        self.fft.inverse_full(spec, table);
     }
 
     /// An operator of the tangential block only, from the real tables of
@@ -513,9 +498,7 @@ impl Operator {
         // bytes.
         let [xx, yy, xy] = [(X, X), (Y, Y), (X, Y)].map(|(i, j)| {
             crate::progress::tick();
-            self.spectra.component(i, j).write_complex(&mut spec);
-            self.fft.to_natural_order(&mut spec);
-            self.fft.inverse_full(&mut spec, &mut table);
+            self.table_into(i, j, &mut spec, &mut table);
             let mut w = vec![Complex64::default(); fft.spectrum_len()];
             for iy in 0..mw {
                 for (ix, r) in row.iter_mut().enumerate() {
@@ -906,7 +889,7 @@ mod tests {
                 assert!((x - y).abs() < 1e-13 * scale, "{x:e} vs {y:e}");
             }
         };
-        close(&whole.zz_table(), &split.zz_table());
+        close(&whole.table(Z, Z), &split.table(Z, Z));
         close(&whole.table(X, Y), &split.table(X, Y));
         assert_eq!(
             whole.with_spectra(Spectra::clone),
