@@ -289,6 +289,7 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
             force,
             extra: None,
             tolerance: 1e-6,
+            slip_floor: 0.0,
             max_iterations: 20_000,
             start: TangentialStart::Proportional,
         };

@@ -258,12 +258,18 @@ pub(crate) fn solve_step(
                     ey[i] -= prev.u.1[i];
                 }
             }
+            let slip_floor = if has_extra {
+                slip_floor(&p, (&ex, &ey)) / step.tolerance_scale
+            } else {
+                0.0
+            };
             let prob = TangentialProblem {
                 p: &p,
                 friction: spec.load.friction,
                 force,
                 extra: has_extra.then_some((&ex[..], &ey[..])),
                 tolerance: tan_tol,
+                slip_floor,
                 max_iterations: num.max_iterations,
                 start: match previous {
                     Some(prev) => TangentialStart::Tractions(prev.start.0, prev.start.1),
@@ -383,6 +389,29 @@ fn rescale_slip(
             tan.qy[i] = b * force[1];
         }
     }
+}
+
+/// Fraction of the extra slip term's largest value on the contact that
+/// floors the scale of the tangential KKT residual (see
+/// [`TangentialProblem::slip_floor`]).
+const SLIP_FLOOR: f64 = 1e-2;
+
+/// The floor of the tangential KKT scale for a pass whose slip carries the
+/// extra term `(ex, ey)`: `SLIP_FLOOR` times its largest magnitude over the
+/// contact cells, i.e. the slip the increment would see if no traction
+/// changed (the inward draw of the pressure's change under Spence's normal
+/// loading with friction; the previous state's displacement in a history).
+/// A history divides it by its tolerance factor, so that the floor stays a
+/// hundredth of the loop's scale: below every increment's |Δδt| in the
+/// histories of the configs (results unchanged to the bit), where δt exists.
+fn slip_floor(p: &[f64], (ex, ey): (&[f64], &[f64])) -> f64 {
+    let mut m = 0.0_f64;
+    for i in 0..p.len() {
+        if p[i] > 0.0 {
+            m = m.max(ex[i].hypot(ey[i]));
+        }
+    }
+    SLIP_FLOOR * m
 }
 
 #[cfg(test)]

@@ -279,7 +279,11 @@ pub(crate) fn reduce(
     // The paper's radii (whole cells) decide what the grid resolves, as
     // before the sub-cell radii existed; the two differ by less than a cell.
     let a = equivalent_radius(hull_area(&grid, &contact));
-    let c = if fnorm > 0.0 {
+    // A history's state has a stick set at any force (at F = 0 the tractions
+    // of Spence's normal loading with friction, or those locked in after
+    // unloading); a monotonic case without force has none.
+    let has_stick_set = fnorm > 0.0 || is_history;
+    let c = if has_stick_set {
         equivalent_radius(hull_area(&grid, &stick_in_contact))
     } else {
         a
@@ -325,7 +329,7 @@ pub(crate) fn reduce(
     // Hertzian edge, and μp − |q| does at a Mindlin stick edge.
     let friction = spec.load.friction;
     let a_sub = equivalent_radius(subcell_hull_area(&grid, &contact, &p, &heights));
-    let c_sub = if fnorm > 0.0 {
+    let c_sub = if has_stick_set {
         let reserve: Vec<f64> = (0..len)
             .map(|i| (friction * p[i] - qx[i].hypot(qy[i])).max(0.0))
             .collect();

@@ -47,6 +47,7 @@ fn problem(p: &[f64]) -> TangentialProblem<'_> {
         force: [0.6 * MU * LOAD, 0.0],
         extra: None,
         tolerance: TOL,
+        slip_floor: 0.0,
         max_iterations: 5000,
         start: TangentialStart::Proportional,
     }

@@ -151,6 +151,7 @@ fn windowed_and_whole_grid_tangential_solves_agree_for_a_111_crystal() {
         force,
         extra: Some((&ex, &ey)),
         tolerance: 1e-10,
+        slip_floor: 0.0,
         max_iterations: 20_000,
         start: TangentialStart::Proportional,
     };
