@@ -3,7 +3,7 @@
 //! direction, one line per cycle) as PNG and SVG. Used by `mpcontact solve`
 //! and, per case, by a sweep; computes nothing the solver did not.
 
-use crate::run::fmt_f64;
+use crate::float_text::fmt_f64;
 use anyhow::Result;
 use plotters::prelude::*;
 use solver::HistoryOutput;

@@ -11,6 +11,7 @@ pub mod config;
 pub mod convergence;
 pub mod cost;
 pub mod dry_run;
+pub mod float_text;
 pub mod history_out;
 pub mod maps;
 pub mod memory;

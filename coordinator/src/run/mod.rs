@@ -30,7 +30,7 @@ use serde::Serialize;
 pub use exchange::Interrupted;
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
-pub use output::{fmt_f64, CURVES_HEADER, RESULTS_HEADER};
+pub use output::{CURVES_HEADER, RESULTS_HEADER};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
 pub use supervise::WorkerCommand;

@@ -16,6 +16,7 @@ use super::journal::Outcome;
 use super::plan::PlannedCase;
 use crate::case::{CaseKey, Status};
 use crate::convergence::{estimate, Estimate};
+use crate::float_text::fmt_f64;
 
 /// Header of `results.csv` (one row per case, see README.md). Users' tools
 /// read these names: change one only with a reason in the docs.
@@ -33,16 +34,6 @@ pub struct Row<'a> {
     pub record: &'a Outcome,
     /// Scalars with the final μa and K_E.
     pub scalars: Option<CaseScalars>,
-}
-
-/// Deterministic float text: shortest round-trip digits, exponent form
-/// outside [1e-3, 1e7).
-pub fn fmt_f64(v: f64) -> String {
-    if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e7) || !v.is_finite() {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
 }
 
 /// Apply the K_E calibration: patterned (and flat) cases of anisotropic
@@ -617,16 +608,6 @@ pub fn write_result_fields(
 mod tests {
     use super::*;
     use solver::{calibrate_k_e, mu_apparent, CaseSpec, Surface};
-
-    #[test]
-    fn float_text_is_shortest_round_trip() {
-        for v in [0.0, 0.3, 1.0 / 3.0, 1.5e-5, 6.02e23, -2.5e-12, 1234.5] {
-            let t = fmt_f64(v);
-            assert_eq!(t.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{t}");
-        }
-        assert_eq!(fmt_f64(1.5e-5), "1.5e-5");
-        assert_eq!(fmt_f64(15.0), "15");
-    }
 
     fn aniso_case(surface_name: &str, surface: Surface) -> PlannedCase {
         let iso = solver::Isotropic::new(130e9, 0.34).unwrap();
