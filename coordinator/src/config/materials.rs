@@ -1,0 +1,193 @@
+//! `[materials.NAME]`: custom materials (isotropic, a full stiffness or
+//! cubic constants with an orientation), how a name resolves (tables first,
+//! then presets) and the config keys of a material's solver parameters.
+
+use super::{within, Config};
+use anyhow::{anyhow, bail, Result};
+use serde::{Deserialize, Serialize};
+use solver::{Isotropic, Material, SolverError};
+
+/// Isotropic constants in GPa.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsoCfg {
+    /// Young's modulus, GPa.
+    pub youngs_gpa: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+}
+
+/// Cubic constants in GPa.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CubicCfg {
+    /// C11, GPa.
+    pub c11: f64,
+    /// C12, GPa.
+    pub c12: f64,
+    /// C44, GPa.
+    pub c44: f64,
+}
+
+/// `[materials.NAME]`: exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialCfg {
+    /// Isotropic constants.
+    pub isotropic: Option<IsoCfg>,
+    /// Full 6x6 Voigt stiffness in the surface frame (xx, yy, zz, yz, xz, xy; z into the body), GPa.
+    pub stiffness_gpa: Option<Vec<Vec<f64>>>,
+    /// Cubic constants, rotated so that z ∥ `normal` and x ∥ `x_dir`.
+    pub cubic_gpa: Option<CubicCfg>,
+    /// Surface normal (Miller indices) for `cubic_gpa`.
+    pub normal: Option<[f64; 3]>,
+    /// In-plane x direction (Miller indices) for `cubic_gpa`.
+    pub x_dir: Option<[f64; 3]>,
+    /// Isotropic-equivalent constants for normalisation (default: Hill average).
+    pub equivalent: Option<IsoCfg>,
+}
+
+/// The key in `[materials.NAME]` of a material parameter.
+pub(super) fn material_key<'a>(param: &'a str, cfg: Option<&MaterialCfg>) -> &'a str {
+    let cubic = cfg.is_some_and(|m| m.cubic_gpa.is_some());
+    match param {
+        "youngs" => "isotropic.youngs_gpa",
+        "poisson" => "isotropic.poisson",
+        "stiffness" if cubic => "cubic_gpa",
+        "stiffness" => "stiffness_gpa",
+        "orientation" => "normal",
+        other => other,
+    }
+}
+
+impl Config {
+    /// Resolves a material name: `[materials.NAME]` first, then presets.
+    pub fn material(&self, name: &str) -> Result<Material> {
+        if let Some(m) = self.materials.get(name) {
+            return build_material(name, m, &|e| self.explain(within("material", e), name, ""));
+        }
+        solver::presets::material(name).ok_or_else(|| {
+            anyhow!("sweep.materials: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
+        })
+    }
+}
+
+/// A material from its `[materials.NAME]` table; `explain` turns the
+/// solver's errors (parameters of the material) into config errors.
+fn build_material(
+    name: &str,
+    m: &MaterialCfg,
+    explain: &dyn Fn(SolverError) -> anyhow::Error,
+) -> Result<Material> {
+    let key = |k: &str| format!("materials.{name}.{k}");
+    let given = [
+        m.isotropic.is_some(),
+        m.stiffness_gpa.is_some(),
+        m.cubic_gpa.is_some(),
+    ]
+    .iter()
+    .filter(|&&b| b)
+    .count();
+    if given != 1 {
+        bail!("materials.{name}: give exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`");
+    }
+    if let Some(iso) = m.isotropic {
+        if m.equivalent.is_some() {
+            bail!(
+                "{}: only applies to anisotropic materials (an isotropic material is its own equivalent)",
+                key("equivalent")
+            );
+        }
+        if m.normal.is_some() || m.x_dir.is_some() {
+            bail!(
+                "{}: `normal`/`x_dir` only apply to `cubic_gpa`",
+                key("normal")
+            );
+        }
+        return Material::isotropic(name, iso.youngs_gpa * 1e9, iso.poisson).map_err(explain);
+    }
+    // The isotropic-equivalent constants only normalise (the paper's Cu(111)
+    // has ν = 0.503): taken as given; the material checks them.
+    let equivalent = m.equivalent.map(|e| Isotropic {
+        youngs: e.youngs_gpa * 1e9,
+        poisson: e.poisson,
+    });
+    if let Some(rows) = &m.stiffness_gpa {
+        if rows.len() != 6 || rows.iter().any(|r| r.len() != 6) {
+            bail!(
+                "{}: must be 6 rows of 6 numbers (GPa)",
+                key("stiffness_gpa")
+            );
+        }
+        let c = nalgebra::Matrix6::from_fn(|i, j| rows[i][j] * 1e9);
+        return Material::with_stiffness(name, c, equivalent).map_err(explain);
+    }
+    let cub = m.cubic_gpa.expect("counted above");
+    let normal = m
+        .normal
+        .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("normal")))?;
+    let x_dir = m
+        .x_dir
+        .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("x_dir")))?;
+    let constants = [cub.c11 * 1e9, cub.c12 * 1e9, cub.c44 * 1e9];
+    Material::cubic(name, constants, normal, x_dir, equivalent).map_err(explain)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixtures::{err, BASE};
+    use crate::config::Config;
+
+    #[test]
+    fn bad_materials_are_explained() {
+        let poisson = format!(
+            "{BASE}\n[materials.rubber]\nisotropic = {{ youngs_gpa = 0.01, poisson = 0.6 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"rubber\"]");
+        assert!(err(&poisson, &[]).contains("(-1, 0.5]"));
+        let zero_e = format!(
+            "{BASE}\n[materials.void]\nisotropic = {{ youngs_gpa = 0.0, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"void\"]");
+        assert!(err(&zero_e, &[]).contains("Young"));
+        let mut rows = vec![vec![0.0; 6]; 6];
+        rows[0][0] = 100.0;
+        let not_pd = format!("{BASE}\n[materials.bad]\nstiffness_gpa = {rows:?}\n")
+            .replace("materials = [\"Fe\"]", "materials = [\"bad\"]");
+        assert!(
+            err(&not_pd, &[]).contains("positive definite"),
+            "{}",
+            err(&not_pd, &[])
+        );
+    }
+
+    #[test]
+    fn issue20_item8_equivalent_constants_are_checked_or_refused() {
+        let iso = format!(
+            "{BASE}\n[materials.soft]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nequivalent = {{ youngs_gpa = nan, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"soft\"]");
+        let e = err(&iso, &[]);
+        assert!(e.contains("materials.soft.equivalent"), "{e}");
+        let aniso = format!(
+            "{BASE}\n[materials.odd]\ncubic_gpa = {{ c11 = 257.1, c12 = 125.9, c44 = 108.6 }}\nnormal = [1, 1, 1]\nx_dir = [1, 1, -2]\nequivalent = {{ youngs_gpa = nan, poisson = 0.3 }}\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"odd\"]");
+        let e = err(&aniso, &[]);
+        assert!(e.contains("materials.odd.equivalent"), "{e}");
+    }
+
+    #[test]
+    fn cubic_material_with_111_normal_reproduces_the_fe111_preset() {
+        // Back-fitted cubic constants of Fe (see docs/validation.md), frame z ∥ [111], x ∥ [11-2].
+        let text = format!(
+            "{BASE}\n[materials.fe111]\ncubic_gpa = {{ c11 = 257.120, c12 = 125.913, c44 = 108.576 }}\nnormal = [1, 1, 1]\nx_dir = [1, 1, -2]\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"fe111\"]");
+        let c = Config::parse(&text, &[]).unwrap();
+        let mine = c.material("fe111").unwrap().stiffness();
+        let preset = solver::presets::material("Fe(111)").unwrap().stiffness();
+        let worst = (mine - preset).amax();
+        assert!(worst < 0.05e9, "max deviation {worst:e} Pa");
+    }
+}

@@ -1,0 +1,238 @@
+//! `[surfaces.NAME]`: custom surfaces (island lattices, stripes, height
+//! maps read from `.npy`), how a name resolves (tables first, then presets,
+//! each built once per config) and the config keys of a surface's parameters.
+
+use super::{within, Config};
+use crate::npy::read_grid_npy;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use solver::{Island, LatticeKind, Surface};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// `[surfaces.NAME]`
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceCfg {
+    /// `flat`, `circle`, `square`, `stripe` or `heightmap`.
+    pub shape: String,
+    /// Circle diameter, µm.
+    pub diameter_um: Option<f64>,
+    /// Square side, µm.
+    pub side_um: Option<f64>,
+    /// Stripe (ridge) width, µm.
+    pub width_um: Option<f64>,
+    /// Lattice or stripe pitch, µm.
+    pub pitch_um: Option<f64>,
+    /// Island / ridge height, µm (negative: dimples / grooves).
+    pub height_um: Option<f64>,
+    /// `square` (default) or `hexagonal` island lattice.
+    pub lattice: Option<String>,
+    /// Ridge direction for stripes, degrees from x (default 90: ridges along y).
+    pub angle_deg: Option<f64>,
+    /// Position of one island centre (or ridge line) relative to the sphere apex, µm.
+    #[serde(default)]
+    pub offset_um: [f64; 2],
+    /// Height map: a 2-D float64 `.npy` of heights in µm, shape (N, N) = the grid,
+    /// rows along y; a relative path is taken from the config file's directory.
+    pub file: Option<String>,
+}
+
+/// Built surfaces by name, shared by the clones of one config.
+#[derive(Clone, Debug, Default)]
+pub(super) struct SurfaceCache(std::sync::Arc<std::sync::Mutex<BTreeMap<String, Surface>>>);
+
+impl SurfaceCache {
+    fn get(&self, name: &str) -> Option<Surface> {
+        let map = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        map.get(name).cloned()
+    }
+    fn insert(&self, name: &str, surface: &Surface) {
+        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        map.insert(name.to_string(), surface.clone());
+    }
+}
+
+/// The key in `[surfaces.NAME]` of a surface parameter (lengths in µm).
+pub(super) fn surface_key(param: &str) -> String {
+    match param {
+        "heights" => "file".to_string(),
+        "pitch" | "height" | "offset" | "diameter" | "side" | "width" => format!("{param}_um"),
+        other => other.to_string(),
+    }
+}
+
+impl Config {
+    /// Resolves a surface name: `[surfaces.NAME]` first, then presets.
+    pub fn surface(&self, name: &str) -> Result<Surface> {
+        if let Some(s) = self.surfaces.get(name) {
+            if let Some(surface) = self.built_surfaces.get(name) {
+                return Ok(surface);
+            }
+            let surface = build_surface(name, s, self.grid.points, &self.base_dir)?;
+            surface
+                .validate(self.grid.points)
+                .map_err(|e| self.explain(within("surface", e), "", name))?;
+            self.built_surfaces.insert(name, &surface);
+            return Ok(surface);
+        }
+        solver::presets::surface(name).ok_or_else(|| {
+            anyhow!("sweep.surfaces: unknown surface `{name}` (presets: flat, circle-A, circle-B, square-A, square-B; or define [surfaces.\"{name}\"])")
+        })
+    }
+}
+
+/// The height-map surface of `n x n` heights in µm, rows along y: what
+/// `shape = "heightmap"` makes of its file (and Python of an array), so
+/// both give the solver the same metres. Not validated (`Surface::validate`).
+pub fn heightmap_surface(n: usize, heights_um: &[f64]) -> Surface {
+    Surface::Heightmap {
+        n,
+        heights: std::sync::Arc::new(heights_um.iter().map(|v| v * 1e-6).collect()),
+    }
+}
+
+fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Surface> {
+    let need = |v: Option<f64>, k: &str| {
+        v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{}\"", s.shape))
+    };
+    let um = 1e-6;
+    let surface = match s.shape.as_str() {
+        "flat" => Surface::Flat,
+        "circle" | "square" => {
+            let island = if s.shape == "circle" {
+                Island::Circle {
+                    diameter: need(s.diameter_um, "diameter_um")? * um,
+                }
+            } else {
+                Island::Square {
+                    side: need(s.side_um, "side_um")? * um,
+                }
+            };
+            let lattice = match s.lattice.as_deref() {
+                None | Some("square") => LatticeKind::Square,
+                Some("hexagonal") => LatticeKind::Hexagonal,
+                Some(other) => bail!("surfaces.{name}.lattice: unknown lattice `{other}` (square, hexagonal)"),
+            };
+            Surface::Lattice {
+                island,
+                pitch: need(s.pitch_um, "pitch_um")? * um,
+                height: need(s.height_um, "height_um")? * um,
+                offset: [s.offset_um[0] * um, s.offset_um[1] * um],
+                lattice,
+            }
+        }
+        "stripe" => Surface::Stripes {
+            width: need(s.width_um, "width_um")? * um,
+            pitch: need(s.pitch_um, "pitch_um")? * um,
+            height: need(s.height_um, "height_um")? * um,
+            angle_deg: s.angle_deg.unwrap_or(90.0),
+            offset: s.offset_um[0] * um,
+        },
+        "heightmap" => {
+            let file = s
+                .file
+                .as_ref()
+                .ok_or_else(|| anyhow!("surfaces.{name}.file: required for shape = \"heightmap\""))?;
+            let path = base.join(file);
+            let values =
+                read_grid_npy(&path, n).with_context(|| format!("surfaces.{name}.file"))?;
+            heightmap_surface(n, &values)
+        }
+        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap)"),
+    };
+    Ok(surface)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fixtures::{err, BASE};
+    use crate::config::Config;
+    use solver::Surface;
+
+    #[test]
+    fn bad_surfaces_are_explained() {
+        let island = format!("{BASE}\n[surfaces.fat]\nshape = \"circle\"\ndiameter_um = 50.0\npitch_um = 40.0\nheight_um = 1.0\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"fat\"]");
+        assert!(
+            err(&island, &[]).contains("does not fit"),
+            "{}",
+            err(&island, &[])
+        );
+        let nan_h = format!("{BASE}\n[surfaces.odd]\nshape = \"square\"\nside_um = 10.0\npitch_um = 40.0\nheight_um = nan\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"odd\"]");
+        assert!(err(&nan_h, &[]).contains("height"), "{}", err(&nan_h, &[]));
+    }
+
+    #[test]
+    fn issue20_item5_a_height_map_is_read_once_and_only_from_a_regular_file() {
+        let tmp_dir = tempfile::tempdir().unwrap();
+        let dir = tmp_dir.path().to_path_buf();
+        let heights = vec![0.0; 64 * 64];
+        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
+        let c = Config::parse_in(&text, &[], &dir).unwrap();
+        // Read when the config was checked; the cases share that one copy,
+        // and a file changed afterwards is not read again.
+        std::fs::remove_file(dir.join("h.npy")).unwrap();
+        let cases = c.cases().unwrap();
+        assert_eq!(cases.len(), 3);
+        let map = |i: usize| match &cases[i].1.surface {
+            Surface::Heightmap { heights, .. } => heights.clone(),
+            _ => panic!("not a height map"),
+        };
+        assert!(std::sync::Arc::ptr_eq(&map(0), &map(2)), "one copy");
+        // A FIFO (which would block a read) and a directory are refused at once.
+        let fifo = dir.join("pipe.npy");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let e = format!(
+                "{:#}",
+                Config::parse_in(&text.replace("h.npy", "pipe.npy"), &[], &dir).unwrap_err()
+            );
+            assert!(
+                e.contains("not a regular file") && e.contains("surfaces.rough.file"),
+                "{e}"
+            );
+        }
+        std::fs::create_dir(dir.join("d.npy")).unwrap();
+        let e = format!(
+            "{:#}",
+            Config::parse_in(&text.replace("h.npy", "d.npy"), &[], &dir).unwrap_err()
+        );
+        assert!(e.contains("not a regular file"), "{e}");
+    }
+
+    #[test]
+    fn heightmap_surface_is_read_from_npy_and_its_shape_checked() {
+        let tmp_dir = tempfile::tempdir().unwrap();
+        let dir = tmp_dir.path().to_path_buf();
+        let heights: Vec<f64> = (0..64 * 64)
+            .map(|i| if i % 7 == 0 { 0.5 } else { 0.0 })
+            .collect();
+        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        crate::npy::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
+        let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
+            .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
+        let c = Config::parse_in(&text, &[], &dir).unwrap();
+        let Surface::Heightmap { n, heights: h } = c.surface("rough").unwrap() else {
+            panic!("not a height map")
+        };
+        assert_eq!(n, 64);
+        assert_eq!(h[0], 0.5e-6, "µm in the file, m in the solver");
+        let small = text.replace("h.npy", "small.npy");
+        let e = format!("{:#}", Config::parse_in(&small, &[], &dir).unwrap_err());
+        assert!(e.contains("grid is 64 x 64"), "{e}");
+        let missing = text.replace("h.npy", "nope.npy");
+        let e = format!("{:#}", Config::parse_in(&missing, &[], &dir).unwrap_err());
+        assert!(e.contains("surfaces.rough.file"), "{e}");
+        // A height map has no finer grids: a ladder on it is refused, by name.
+        let sets = ["convergence.levels=2".to_string()];
+        let e = format!("{:#}", Config::parse_in(&text, &sets, &dir).unwrap_err());
+        assert!(
+            e.contains("convergence.levels = 2: surface `rough` is a height map"),
+            "{e}"
+        );
+    }
+}
