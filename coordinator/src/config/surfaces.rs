@@ -1,6 +1,6 @@
 //! `[surfaces.NAME]`: custom surfaces (island lattices, stripes, height
-//! maps read from `.npy`), how a name resolves (tables first, then presets,
-//! each built once per config) and the config keys of a surface's parameters.
+//! maps read from `.npy`), how a name resolves (tables first, each built
+//! once per config, then presets) and the config keys of its parameters.
 
 use super::{within, Config};
 use crate::npy::read_grid_npy;
