@@ -185,8 +185,9 @@ fn two_workers_record_every_case_once_reuse_kernels_and_leave_no_shm() {
         assert!(mu.is_finite(), "{r:?}");
     }
 
-    // Both workers worked; each built each (material, grid) kernel once:
-    // its kernel count equals the number of materials it solved.
+    // Both workers worked; each made each (material, grid) kernel resident
+    // once, built or loaded from the store: the journal's `kernel_builds`
+    // (kernels resident) equals the number of materials it solved.
     let mut materials_by_worker: BTreeMap<u64, BTreeSet<String>> = BTreeMap::new();
     let mut builds_by_worker: BTreeMap<u64, u64> = BTreeMap::new();
     for v in &journal {
@@ -207,9 +208,20 @@ fn two_workers_record_every_case_once_reuse_kernels_and_leave_no_shm() {
         + summary["not_converged"].as_u64().unwrap()
         + summary["failed"].as_u64().unwrap();
     assert_eq!(counted, CASES as u64);
+    let mut built = 0;
     for (w, b) in builds_by_worker {
+        let report = &summary["per_worker"][w.to_string()];
+        let count = |key: &str| report[key].as_u64().unwrap();
+        assert_eq!(
+            count("kernels_built") + count("kernels_loaded"),
+            b,
+            "worker {w}: {report}"
+        );
+        built += count("kernels_built");
+        // The deprecated key keeps its meaning: kernels made resident.
         assert_eq!(summary["kernel_builds"][w.to_string()], b);
     }
+    assert_eq!(summary["kernels_built"], built);
     assert!(summary["config"].as_str().unwrap().contains("circle-A"));
     assert!(o.join("mu_a_vs_angle.svg").exists());
 

@@ -161,11 +161,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     }
     progress.finish();
 
-    summary.kernel_builds = summary
-        .per_worker
-        .iter()
-        .map(|(k, w)| (k.clone(), w.kernel_builds))
-        .collect();
+    summary.count_kernels();
     let (cases, outcomes) = recorder.results();
     summary.tally(cases, outcomes);
     summary.wall_seconds = started.elapsed().as_secs_f64();

@@ -11,18 +11,63 @@ use super::journal::Outcome;
 use super::plan::PlannedCase;
 use crate::case::Status;
 
-/// Per-worker statistics in `summary.json`.
+/// Per-worker statistics, as `dispatch` takes them from the worker's
+/// messages; `summary.json` shows them as a [`WorkerReport`].
 #[derive(Clone, Debug, Default, Serialize)]
+#[serde(into = "WorkerReport")]
 pub struct WorkerSummary {
     /// Cases this worker recorded.
     pub cases: u64,
-    /// Kernels (operators) it built — once per (material, grid) it saw.
+    /// Kernels (operators) it made resident, built or loaded: the wire's
+    /// `kernel_builds` (`KernelCache::builds()`), once per (material, grid).
     pub kernel_builds: u64,
     /// Of those, how many it loaded from the kernel store (built by another
     /// worker, which it waited for, or by an earlier run) instead of computing.
     pub kernel_loads: u64,
     /// It died (or was lost) during the run.
     pub died: bool,
+}
+
+impl WorkerSummary {
+    /// Kernels this worker computed itself (resident and not loaded).
+    pub fn kernels_built(&self) -> u64 {
+        // Both counts are maxima over the worker's messages; a load seen in
+        // a result that was not recorded (a duplicate) must not wrap this.
+        self.kernel_builds.saturating_sub(self.kernel_loads)
+    }
+}
+
+/// One worker in `summary.json` → `per_worker`: the kernels it built and
+/// loaded under names that say so, beside the old keys. `kernel_builds`
+/// counted loads too, so a reader took one build and one load for two
+/// builds; it stays, with that meaning, for readers of older summaries.
+#[derive(Serialize)]
+struct WorkerReport {
+    /// Cases this worker recorded.
+    cases: u64,
+    /// Kernels it computed itself.
+    kernels_built: u64,
+    /// Kernels it loaded from the kernel store instead of computing them.
+    kernels_loaded: u64,
+    /// Deprecated: `kernels_built + kernels_loaded` (kernels made resident).
+    kernel_builds: u64,
+    /// Deprecated: the same as `kernels_loaded`.
+    kernel_loads: u64,
+    /// It died (or was lost) during the run.
+    died: bool,
+}
+
+impl From<WorkerSummary> for WorkerReport {
+    fn from(w: WorkerSummary) -> Self {
+        WorkerReport {
+            cases: w.cases,
+            kernels_built: w.kernels_built(),
+            kernels_loaded: w.kernel_loads,
+            kernel_builds: w.kernel_builds,
+            kernel_loads: w.kernel_loads,
+            died: w.died,
+        }
+    }
 }
 
 /// IPC cost of results by grid size (clocks of one machine).
@@ -69,7 +114,14 @@ pub struct RunSummary {
     pub workers: usize,
     /// Statistics by worker index.
     pub per_worker: BTreeMap<String, WorkerSummary>,
-    /// Kernel builds by worker index (same numbers as `per_worker`).
+    /// Kernels computed by all workers (the sum of `per_worker` →
+    /// `kernels_built`); with a shared kernel store, each (material, grid)
+    /// at most once.
+    pub kernels_built: u64,
+    /// Kernels loaded from the kernel store by all workers.
+    pub kernels_loaded: u64,
+    /// Deprecated: by worker index, the kernels it made resident, built or
+    /// loaded (`per_worker` → `kernel_builds`); kept for existing readers.
     pub kernel_builds: BTreeMap<String, u64>,
     /// Wall time of the sweep, s.
     pub wall_seconds: f64,
@@ -100,6 +152,18 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
+    /// The kernel counts of the whole run, from `per_worker`.
+    pub fn count_kernels(&mut self) {
+        let workers = self.per_worker.values();
+        self.kernels_built = workers.clone().map(WorkerSummary::kernels_built).sum();
+        self.kernels_loaded = workers.map(|w| w.kernel_loads).sum();
+        self.kernel_builds = self
+            .per_worker
+            .iter()
+            .map(|(k, w)| (k.clone(), w.kernel_builds))
+            .collect();
+    }
+
     /// Count the recorded cases by status; list failures and non-converged
     /// cases by their display text.
     pub fn tally(&mut self, cases: &[PlannedCase], outcomes: &[Option<Outcome>]) {
@@ -170,5 +234,77 @@ impl IpcTimes {
                 }
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use solver::KernelCache;
+    use worker::kernel_store::FileStore;
+
+    /// A worker's statistics as `dispatch` takes them from its results,
+    /// whose counts are the worker's `KernelCache::builds()` (kernels made
+    /// resident, loads included) and `loads()`.
+    fn seen_by_dispatch(cache: &KernelCache) -> WorkerSummary {
+        WorkerSummary {
+            cases: 1,
+            kernel_builds: cache.builds() as u64,
+            kernel_loads: cache.loads() as u64,
+            died: false,
+        }
+    }
+
+    #[test]
+    fn two_kernel_builds_read_as_two_built_and_a_store_load_as_loaded() {
+        // Two anisotropic kernels (stored on disk; isotropic ones are closed
+        // forms and never stored) on a small grid.
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../configs/quick.toml"),
+        )
+        .unwrap();
+        let config = Config::parse(&text, &["grid.points=32".into()]).unwrap();
+        let spec = |m: &str| config.spec(m, "flat", 0.0).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let store = || KernelCache::with_store(Box::new(FileStore::new(tmp.path().join("k"))));
+        // Worker 0 computes both; worker 1 then finds Cu(111) in the store.
+        let mut first = store();
+        first.resident(&spec("Cu(111)")).unwrap();
+        first.resident(&spec("Fe(111)")).unwrap();
+        let mut second = store();
+        second.resident(&spec("Cu(111)")).unwrap();
+
+        let mut summary = RunSummary::default();
+        summary
+            .per_worker
+            .insert("0".into(), seen_by_dispatch(&first));
+        summary
+            .per_worker
+            .insert("1".into(), seen_by_dispatch(&second));
+        summary.count_kernels();
+        let json = serde_json::to_value(&summary).unwrap();
+        let w0 = &json["per_worker"]["0"];
+        let w1 = &json["per_worker"]["1"];
+        assert_eq!(
+            (w0["kernels_built"].as_u64(), w0["kernels_loaded"].as_u64()),
+            (Some(2), Some(0))
+        );
+        assert_eq!(
+            (w1["kernels_built"].as_u64(), w1["kernels_loaded"].as_u64()),
+            (Some(0), Some(1))
+        );
+        assert_eq!(
+            (
+                json["kernels_built"].as_u64(),
+                json["kernels_loaded"].as_u64()
+            ),
+            (Some(2), Some(1))
+        );
+        // The deprecated keys keep their meaning: kernels made resident.
+        assert_eq!(w0["kernel_builds"], 2);
+        assert_eq!(w1["kernel_builds"], 1);
+        assert_eq!(w1["kernel_loads"], 1);
+        assert_eq!(json["kernel_builds"], serde_json::json!({ "0": 2, "1": 1 }));
     }
 }
