@@ -16,7 +16,7 @@ use crate::error::SolverError;
 use crate::grid::Grid;
 use crate::multilevel::{coarse_table, prolong, restrict};
 use crate::operator::{Operator, X, Y};
-use crate::tangential::{solve_tangential_on_grid, TangentialProblem, TangentialStart};
+use crate::tangential_problem::{TangentialProblem, TangentialSolution, TangentialStart};
 
 /// Smallest grid that is still coarsened further (as the normal solver's levels).
 const MIN_COARSE_N: usize = 32;
@@ -92,14 +92,22 @@ impl TangentialLevels {
 /// iterations spent on them.
 pub(crate) type CoarseStart = (Vec<f64>, Vec<f64>, usize);
 
+/// The single-grid tangential solve run on each coarse level. The tangential
+/// solver passes its own (`tangential::solve_tangential_on_grid`): it sits
+/// above this module, which therefore never imports it.
+pub(crate) type GridSolve =
+    fn(&mut Operator, &TangentialProblem) -> Result<TangentialSolution, SolverError>;
+
 /// A start for the fine solve of `prob` (on the grid `levels` were made for):
 /// the tractions of the coarse solves, coarsest first, each prolonged to the
 /// next level, and the coarse iterations spent. `None` when there are no
 /// levels or a coarse problem has no partial-slip solution (the fine solve
-/// then starts as asked, and reports its own verdict).
+/// then starts as asked, and reports its own verdict). Each level is solved
+/// by `solve_on_grid`.
 pub(crate) fn coarse_start(
     levels: &mut TangentialLevels,
     prob: &TangentialProblem,
+    solve_on_grid: GridSolve,
 ) -> Result<Option<CoarseStart>, SolverError> {
     if levels.is_empty() {
         return Ok(None);
@@ -137,7 +145,7 @@ pub(crate) fn coarse_start(
             },
             ..*prob
         };
-        let solved = solve_tangential_on_grid(op, &sub);
+        let solved = solve_on_grid(op, &sub);
         // A level is used once per start: its work spectra are not kept
         // between starts (see `Operator::release_work`).
         op.release_work();
@@ -170,7 +178,7 @@ pub(crate) fn coarse_start(
 /// Interpolating `q` itself would blur the slip zone's `|q| = μp` where `p`
 /// falls to zero at the contact edge.
 fn prolong_tractions(
-    sol: &crate::tangential::TangentialSolution,
+    sol: &TangentialSolution,
     pc: &[f64],
     pf: &[f64],
     mu: f64,

@@ -34,6 +34,24 @@
 //! `normal`, `tangential`, `window`), for problems other than a case: the
 //! model / operator / solver split of Tamaas. Modules marked hidden are
 //! public only for this crate's own tests, benches and examples.
+//!
+//! ## Layers
+//!
+//! Each module imports only from its own layer or those before it in this
+//! list, never in a circle; a type two layers need lives in the lower one:
+//!
+//! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`
+//! 2. Green's functions: `influence`, `aniso`
+//! 3. description of a case: `material`, `surface`, `presets`, `spec`
+//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables)
+//! 5. single-field solvers: `normal`; `tangential_problem` (the tangential
+//!    solve's inputs and outputs) → `coarse_slip` → `window` → `tangential`
+//! 6. resident kernels: `kernels` (an operator with the caches the solvers
+//!    of layer 5 made for it, hence after them)
+//! 7. load steps: `coupling` (one step, the coupling loop), `history` (a
+//!    load path of steps)
+//! 8. results: `results` (scalars and fields of a solved state)
+//! 9. the driver: `case` (`solve_case`)
 
 pub mod aniso;
 mod case;
@@ -61,6 +79,7 @@ mod results;
 mod spec;
 mod surface;
 pub mod tangential;
+mod tangential_problem;
 pub mod window;
 
 pub use case::solve_case;

@@ -11,7 +11,7 @@ use crate::geometry::{equivalent_radius, hull_area, subcell_hull_area};
 use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
-use crate::spec::{CaseSpec, Load};
+use crate::spec::{CaseSpec, Load, MIN_RESOLVED_CELLS};
 use crate::tangential::{TangentialReport, TangentialSolution};
 
 /// The scalars of one solved case.
@@ -220,9 +220,6 @@ pub fn calibrate_on_flat(s: &mut CaseScalars, flat: &CaseScalars, load: &Load) {
     );
     s.mu_a_cells = mu_apparent_cells(s, load.normal_force_n, s.k_e_cells);
 }
-
-/// Smallest apparent contact or stick radius reported, in cells.
-pub const MIN_RESOLVED_CELLS: f64 = 2.0;
 
 /// The fields and scalars of a solved case: total displacements from all
 /// tractions, radii, shifts, forces and μa with the isotropic-equivalent K_E.

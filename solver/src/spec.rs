@@ -16,6 +16,12 @@ use serde::{Deserialize, Serialize};
 /// (`coordinator::memory`, with the estimate in its message).
 pub const MAX_GRID_POINTS: usize = 16384;
 
+/// Smallest apparent contact or stick radius reported, in cells: what a
+/// grid resolves. Part of a case's description because validation rejects a
+/// case whose Hertz radius is below it before anything is solved; the
+/// results apply the same bound to the solved radii.
+pub const MIN_RESOLVED_CELLS: f64 = 2.0;
+
 /// The sphere and what is applied to it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Load {
@@ -374,12 +380,12 @@ impl CaseSpec {
         let a_hertz = (3.0 * normal_min * load.indenter_radius_m
             / (4.0 * self.material.equivalent.plane_strain()))
         .cbrt();
-        let min = crate::results::MIN_RESOLVED_CELLS * grid.dx;
+        let min = MIN_RESOLVED_CELLS * grid.dx;
         if a_hertz < min {
             return Err(SolverError::ContactUnresolved {
                 detail: format!(
                     "the Hertz contact radius {a_hertz:.3e} m spans fewer than {} cells of {:.3e} m",
-                    crate::results::MIN_RESOLVED_CELLS,
+                    MIN_RESOLVED_CELLS,
                     grid.dx
                 ),
             });
