@@ -19,3 +19,4 @@ pub mod npy;
 pub mod run;
 pub mod shard;
 pub mod solve;
+pub mod solve_progress;

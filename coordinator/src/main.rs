@@ -101,6 +101,9 @@ enum Cmd {
         /// the same to the bit for any number.
         #[arg(long, value_name = "N")]
         threads: Option<std::num::NonZeroUsize>,
+        /// No progress line on stderr (there is none when stderr is not a terminal).
+        #[arg(long)]
+        quiet: bool,
     },
     /// Print the Fourier-domain surface compliance H(θ) of a material as JSON.
     Kernel {
@@ -272,6 +275,7 @@ fn real_main() -> Result<()> {
             out,
             sets,
             threads,
+            quiet,
         } => {
             let cfg = Config::load(&config, &sets)?;
             let threads = threads.map_or_else(solver::Threads::available, |n| n.get());
@@ -283,6 +287,7 @@ fn real_main() -> Result<()> {
                     angle_deg,
                     out: &out,
                     threads,
+                    quiet,
                 },
             )?;
             println!(

@@ -1,12 +1,14 @@
 //! One case in-process (no IPC), for inspection. [`solve_in_memory`] is the
 //! part shared by `mpcontact solve` and the Python module (spec, memory
 //! check, solve, flat-twin K_E, the `case.json` value); [`write_solved`] is
-//! the CLI's files (`case.json`, `.npy` fields via `npy`, PNG maps). Touches
-//! no sweep state (plan, journal, workers).
+//! the CLI's files (`case.json`, `.npy` fields via `npy`, PNG maps), and
+//! [`run_solve`] the CLI's whole command (with its progress line,
+//! `solve_progress`). Touches no sweep state (plan, journal, workers).
 
 use crate::case::Status;
 use crate::config::Config;
 use crate::npy::write_fields;
+use crate::solve_progress::SolveProgress;
 use anyhow::{anyhow, Context, Result};
 use serde::Serialize;
 use solver::{calibrate_on_flat, solve_case, CaseScalars, CaseSpec, Fields, Surface};
@@ -56,6 +58,8 @@ pub struct SolveArgs<'a> {
     pub out: &'a Path,
     /// Threads for the case (results do not depend on it).
     pub threads: usize,
+    /// No progress line (there is none anyway when stderr is not a terminal).
+    pub quiet: bool,
 }
 
 /// One case picked from a config and checked: its names and its spec.
@@ -226,7 +230,12 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
 /// Solves one case of `config` and writes its outputs; returns its scalars.
 pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
-    let solved = solve_in_memory(case, args.threads)?;
+    let label = format!("{}/{}/{}°", case.material, case.surface, case.angle_deg);
+    let progress = SolveProgress::start(args.quiet, &label);
+    let solved = solve_in_memory(case, args.threads);
+    // The line is cleared before anything else is printed (warnings, the result).
+    drop(progress);
+    let solved = solved?;
     write_solved(&solved, args.out)?;
     Ok(solved.scalars)
 }

@@ -25,6 +25,7 @@ fn check_inside(n: usize, p: &[f64]) -> Result<(), SolverError> {
 
 /// Solves one case. Its kernel comes from (and stays in) `cache`.
 pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
+    crate::progress::start_case();
     spec.validate()?;
     let (res, kernel_seconds) = cache.resident(spec)?;
     let started = std::time::Instant::now();

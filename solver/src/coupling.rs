@@ -218,7 +218,7 @@ pub(crate) fn solve_step(
         let mut prev_change: f64 = 1e-2;
         let mut anderson = Anderson::new(ANDERSON_DEPTH, len);
         for k in 1..=num.max_coupling_iterations {
-            crate::progress::tick_or_cancel()?;
+            crate::progress::pass(num.coupling.then_some(k))?;
             coupling_iterations = k;
             let exact_pass = !num.coupling || prev_change < 10.0 * num.coupling_tolerance;
             // In the final passes the tangential residual must not show as a

@@ -177,7 +177,7 @@ pub(crate) fn solve_history(
     for (segment, pair) in points.windows(2).enumerate() {
         let ((pa, fa), (pb, fb)) = (pair[0], pair[1]);
         for m in 1..=steps {
-            crate::progress::tick_or_cancel()?;
+            crate::progress::increment(segment * steps + m, (points.len() - 1) * steps)?;
             let t = m as f64 / steps as f64;
             let (p_k, f_k) = if m == steps {
                 (pb, fb)

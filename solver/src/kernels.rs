@@ -12,6 +12,7 @@ use crate::material::Material;
 use crate::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
 use crate::operator::{Operator, Spectra};
 use crate::parallel::Threads;
+use crate::progress::Stage;
 use crate::spec::CaseSpec;
 use crate::tangential::{
     solve_tangential, solve_tangential_taking, TangentialProblem, TangentialSolution,
@@ -115,7 +116,6 @@ impl Resident {
         }
     }
 
-    /// [`solve_normal`] on this bundle.
     /// Runs this kernel's transforms on `threads` (a window operator made
     /// for other threads is dropped and made again when next needed).
     pub fn set_threads(&mut self, threads: &Threads) {
@@ -126,6 +126,7 @@ impl Resident {
         }
     }
 
+    /// [`solve_normal`] on this bundle.
     pub fn solve_normal(&mut self, prob: &NormalProblem) -> Result<NormalSolution, SolverError> {
         solve_normal(&mut self.operator, &mut self.normal, prob)
     }
@@ -199,6 +200,7 @@ impl KernelCache {
         let key = KernelKey::of(spec);
         let mut took = 0.0;
         if !self.resident.contains_key(&key) {
+            crate::progress::stage(Stage::Kernel);
             let start = std::time::Instant::now();
             let grid = spec.grid;
             let len = Spectra::len_for(grid.n);

@@ -90,7 +90,7 @@ pub use kernels::{build_operator, BuildLock, KernelCache, KernelKey, KernelStore
 pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
 pub use operator::{Operator, Spectra};
 pub use parallel::Threads;
-pub use progress::{cancel, set_tick_hook, TickHook};
+pub use progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
     APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS, K_E_DEFINITION,

@@ -430,6 +430,7 @@ pub fn solve_normal(
     cache: &mut NormalCache,
     prob: &NormalProblem,
 ) -> Result<NormalSolution, SolverError> {
+    crate::progress::stage(crate::progress::Stage::Normal);
     let NormalProblem {
         h0,
         extra_gap,

@@ -194,6 +194,7 @@ pub(crate) fn solve_tangential_taking(
     prob: &TangentialProblem,
     handed: Handed,
 ) -> Result<TangentialSolution, SolverError> {
+    crate::progress::stage(crate::progress::Stage::Tangential);
     let n = op.grid().n;
     let Some(win) = contact_window(n, prob.p) else {
         let levels = windows.grid_levels(op);

@@ -1,5 +1,6 @@
 //! End-to-end tests of the `mpcontact` binary's single-process commands:
-//! `solve` outputs, clear errors for bad input (never a panic), `kernel` JSON.
+//! `solve` outputs and its progress line, clear errors for bad input (never
+//! a panic), `kernel` JSON.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -107,6 +108,102 @@ fn solve_writes_case_json_nine_npy_fields_and_five_maps() {
         let bytes = std::fs::read(dir.join(format!("o/{name}.png"))).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{name}.png is a PNG");
     }
+}
+
+/// Words only the progress line of `solve` prints (stage, increment, pass).
+const PROGRESS_WORDS: [&str; 4] = ["iteration", "increment", "pass ", "building the kernel"];
+
+/// A short fretting history (15 increments at 64², about a second): long
+/// enough for the progress line to be drawn several times.
+fn fretting_small() -> String {
+    format!(
+        "{SMALL}\n[history]\nfretting = {{ amplitude_ratio = 0.6, cycles = 1 }}\nsteps_per_segment = 5\n"
+    )
+}
+
+#[test]
+fn issue33_item2_solve_shows_progress_only_on_a_terminal_and_not_with_quiet() {
+    let tmp_dir = temp_dir("progress");
+    let dir = tmp_dir.path().to_path_buf();
+    let config = dir.join("c.toml");
+    std::fs::write(&config, fretting_small()).unwrap();
+    let solve = |out: &str, quiet: bool| -> Vec<String> {
+        let mut args = vec![
+            "solve".to_string(),
+            config.display().to_string(),
+            "--out".into(),
+            dir.join(out).display().to_string(),
+        ];
+        if quiet {
+            args.push("--quiet".into());
+        }
+        args
+    };
+
+    // stderr a pipe (a log, a batch job): no progress, not even with the
+    // line cleared; the result line on stdout as always.
+    for (out, quiet) in [("pipe", false), ("pipe-quiet", true)] {
+        let o = Command::new(exe())
+            .args(solve(out, quiet))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert!(
+            !PROGRESS_WORDS.iter().any(|w| err.contains(w)) && !err.contains('\r'),
+            "progress on a pipe (quiet = {quiet}): {err:?}"
+        );
+        assert!(String::from_utf8_lossy(&o.stdout).starts_with("a = "));
+    }
+
+    // On a terminal (a pseudo-terminal from util-linux `script`): the line
+    // shows the increments and iterations, and `--quiet` silences it.
+    let has_script = Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("no `script` (util-linux) to run solve on a terminal: that half is not checked");
+        return;
+    }
+    let on_terminal = |args: Vec<String>| -> String {
+        let line = std::iter::once(exe().display().to_string())
+            .chain(args)
+            .map(|a| format!("'{a}'"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let o = Command::new("script")
+            .args(["-q", "-e", "-c", &line, "/dev/null"])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{text}");
+        text
+    };
+    let shown = on_terminal(solve("tty", false));
+    for w in ["increment ", "/15", "pass ", "iteration "] {
+        assert!(shown.contains(w), "no `{w}` in the progress: {shown:?}");
+    }
+    let quiet = on_terminal(solve("tty-quiet", true));
+    assert!(
+        !PROGRESS_WORDS.iter().any(|w| quiet.contains(w)),
+        "--quiet on a terminal: {quiet:?}"
+    );
+    assert!(quiet.contains("a = "), "{quiet:?}");
+    // Progress changes no number: the same case.json with and without it
+    // (but for the timings).
+    let scalars = |out: &str| {
+        let mut v: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(out).join("case.json")).unwrap(),
+        )
+        .unwrap();
+        for k in ["seconds", "kernel_seconds"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+        v
+    };
+    assert_eq!(scalars("tty"), scalars("pipe"));
+    assert_eq!(scalars("tty-quiet"), scalars("pipe"));
 }
 
 fn expect_error(config: &str, sets: &[&str], needle: &str) {
