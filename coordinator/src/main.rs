@@ -228,7 +228,7 @@ fn refine_set(refine: Option<usize>) -> Option<String> {
     refine.map(|levels| format!("convergence.levels={levels}"))
 }
 
-fn real_main() -> Result<()> {
+fn real_main() -> Result<ExitCode> {
     match Cli::parse().cmd {
         Cmd::Run {
             config,
@@ -252,7 +252,7 @@ fn real_main() -> Result<()> {
             let workers = worker_count(workers)?;
             if dry_run {
                 print!("{}", check_report(&path, &config, workers)?);
-                return Ok(());
+                return Ok(ExitCode::SUCCESS);
             }
             let args = coordinator::run::RunArgs {
                 config,
@@ -265,7 +265,7 @@ fn real_main() -> Result<()> {
                 shard,
             };
             coordinator::run::run_sweep(&args)?;
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Solve {
             config,
@@ -302,7 +302,7 @@ fn real_main() -> Result<()> {
                 s.converged,
                 out.join("case.json").display()
             );
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Merge { shards, out } => {
             let s = coordinator::run::merge_shards(&shards, &out)?;
@@ -315,7 +315,7 @@ fn real_main() -> Result<()> {
                 s.failed,
                 out.display()
             );
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Check {
             config,
@@ -326,29 +326,37 @@ fn real_main() -> Result<()> {
             sets.extend(refine_set(refine));
             let cfg = Config::load(&config, &sets)?;
             print!("{}", check_report(&config, &cfg, worker_count(workers)?)?);
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Kernel {
             material,
             angles_deg,
         } => {
             println!("{}", kernel_json(&material, &parse_angles(&angles_deg)?)?);
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Materials => {
             print!("{}", materials_table());
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
-        Cmd::Worker { run, index } => worker::run_worker::<coordinator::case::CaseKey>(
-            &run,
-            index.unwrap_or(1000 + std::process::id() as usize),
-        ),
+        Cmd::Worker { run, index } => {
+            let end = worker::run_worker::<coordinator::case::CaseKey>(
+                &run,
+                index.unwrap_or(1000 + std::process::id() as usize),
+            )?;
+            if end == worker::WorkerEnd::CoordinatorGone {
+                // Tells our coordinator, should it still be there, that this
+                // worker held no case (see protocol::EXIT_LEFT_WAITING).
+                return Ok(ExitCode::from(protocol::EXIT_LEFT_WAITING));
+            }
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
 fn main() -> ExitCode {
     match real_main() {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

@@ -13,7 +13,9 @@ use coordinator::case::CaseKey;
 // The worker's fault-injection hooks (cargo feature `fault-injection`, which
 // this crate's dev-dependency on the worker enables): hang or crash a worker
 // on a named case. This import fails to compile without them.
-use worker::fault_injection::{CRASH_CASE_ENV, HANG_CASE_ENV, HANG_MARKER_ENV};
+use worker::fault_injection::{
+    CRASH_CASE_ENV, HANG_CASE_ENV, HANG_MARKER_ENV, JOURNAL_SYNC_DELAY_ENV,
+};
 
 const EXE: &str = env!("CARGO_BIN_EXE_mpcontact");
 
@@ -1124,4 +1126,180 @@ fn issue16_a_fretting_sweep_reports_energy_per_cycle_and_per_case_loops() {
         std::fs::read_to_string(solved.join("history.csv")).unwrap(),
         std::fs::read_to_string(case.join("history.csv")).unwrap()
     );
+}
+
+/// A sweep whose cases all come out `ok` (flat surfaces only; circle-A on
+/// this coarse grid has unresolved slip zones), 14 cases.
+const ALL_OK_CONFIG: &str = r#"
+[grid]
+points = 32
+spacing_um = 200.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.3
+
+[sweep]
+materials = ["Cu", "Ni"]
+surfaces = ["flat"]
+angles_deg = { start = 0, stop = 180, step = 30 }
+
+[solver]
+coupling = false
+tolerance = 1e-6
+max_iterations = 2000
+"#;
+
+/// Statuses of results.csv by case id.
+fn statuses(out: &Path) -> BTreeMap<String, String> {
+    let rows = read_csv(&out.join("results.csv"));
+    rows[1..]
+        .iter()
+        .map(|r| (format!("{}/{}/{}", r[0], r[1], r[2]), r[3].clone()))
+        .collect()
+}
+
+/// Worker log files of a run (one per worker started, replacements too).
+fn worker_logs(out: &Path) -> Vec<(String, String)> {
+    let mut logs: Vec<(String, String)> = std::fs::read_dir(out.join("worker-logs"))
+        .unwrap()
+        .flatten()
+        .map(|e| {
+            let text = std::fs::read_to_string(e.path()).unwrap_or_default();
+            (e.file_name().to_string_lossy().to_string(), text)
+        })
+        .collect();
+    logs.sort();
+    logs
+}
+
+/// #33 item 3: with the journal on a slow disk (every sync 0.5 s, test
+/// hook), no healthy worker leaves and no case is charged. Before, a worker
+/// whose answer came later than its 0.5 s wait found its request closed —
+/// the coordinator closes a request right after answering it — and left
+/// with its next case unread ("coordinator … is gone (it dropped this
+/// worker's request)"); five left a quick sweep at 300 ms per sync, and a
+/// case was failed for two of them.
+#[test]
+fn issue33_item3_a_slow_journal_loses_no_worker_and_fails_no_case() {
+    let dir = scratch("slowjournal");
+    std::fs::write(dir.join("sweep.toml"), ALL_OK_CONFIG).unwrap();
+    let started = std::time::Instant::now();
+    let mut cmd = sweep_cmd(&dir, "out", 2, "sj");
+    cmd.env(JOURNAL_SYNC_DELAY_ENV, "500");
+    let out = output_within(cmd, 240);
+    let took = started.elapsed().as_secs_f64();
+    check_ok(&out, "sweep with a slow journal");
+    let o = dir.join("out");
+    let st = statuses(&o);
+    assert_eq!(st.len(), 14);
+    for (case, status) in &st {
+        assert_eq!(status, "ok", "{case}");
+    }
+    let journal = journal_cases(&o);
+    let ids: BTreeSet<&str> = journal
+        .iter()
+        .filter_map(|v| v["case_id"].as_str())
+        .collect();
+    assert_eq!((journal.len(), ids.len()), (14, 14), "a case twice or lost");
+    // 14 cases at 0.5 s per sync (plus the header's): the hook was on.
+    assert!(took > 7.0, "the journal was not slowed: {took:.1} s");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("died") && !err.contains("left while"),
+        "{err}"
+    );
+    let logs = worker_logs(&o);
+    assert_eq!(logs.len(), 2, "a worker was replaced: {logs:?}");
+    for (name, text) in &logs {
+        assert!(!text.contains("is gone"), "{name}: {text}");
+    }
+    let s = summary(&o);
+    for (k, w) in s["per_worker"].as_object().unwrap() {
+        assert_eq!(w["died"], false, "worker {k}: {w}");
+    }
+    eprintln!("slow journal (0.5 s per sync): 14 cases in {took:.1} s, 0 workers replaced");
+}
+
+/// #33 item 4: a coordinator paused (SIGSTOP) for 3 s and resumed (SIGCONT)
+/// carries on — before, the signal that cut its wait short ended the run
+/// with "error: interrupted" — and gives the results of an unpaused run;
+/// SIGTERM still interrupts a run.
+#[test]
+fn issue33_item4_a_paused_coordinator_carries_on_and_sigterm_still_stops_it() {
+    let dir = scratch("pause");
+    // Cases of about 0.5 s (256²), so that the coordinator is paused where
+    // it spends a sweep: waiting for workers (about 4 s unpaused).
+    let config = ALL_OK_CONFIG
+        .replace("points = 32", "points = 256")
+        .replace("spacing_um = 200.0", "spacing_um = 25.0");
+    std::fs::write(dir.join("sweep.toml"), config).unwrap();
+    check_ok(
+        &sweep_cmd(&dir, "plain", 2, "pa").output().unwrap(),
+        "unpaused sweep",
+    );
+    let journalled = |o: &Path| {
+        std::fs::read_to_string(o.join("journal.jsonl"))
+            .map(|t| t.lines().count().saturating_sub(1))
+            .unwrap_or(0)
+    };
+    let paused_out = dir.join("paused");
+    let cmd = sweep_cmd(&dir, "paused", 2, "pb");
+    let (status, lines) = run_timed(cmd, |pid| {
+        let t = std::time::Instant::now();
+        while journalled(&paused_out) < 2 {
+            assert!(t.elapsed().as_secs() < 60, "sweep did not start");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let sig = |s: &str| {
+            assert!(Command::new("kill")
+                .args([s, &pid.to_string()])
+                .status()
+                .unwrap()
+                .success())
+        };
+        sig("-STOP");
+        std::thread::sleep(std::time::Duration::from_secs(3));
+        sig("-CONT");
+    });
+    let err: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert!(
+        status.success(),
+        "paused sweep: {status}\n{}",
+        err.join("\n")
+    );
+    assert!(journalled(&paused_out) == 14, "{}", err.join("\n"));
+    assert_eq!(
+        physics_columns(&paused_out.join("results.csv")),
+        physics_columns(&dir.join("plain/results.csv"))
+    );
+    assert_eq!(worker_logs(&paused_out).len(), 2, "a worker was replaced");
+
+    // SIGTERM mid-sweep ends it as an interruption.
+    let stopped_out = dir.join("stopped");
+    let cmd = sweep_cmd(&dir, "stopped", 2, "pc");
+    let (status, lines) = run_timed(cmd, |pid| {
+        let t = std::time::Instant::now();
+        while journalled(&stopped_out) < 1 {
+            assert!(t.elapsed().as_secs() < 60, "sweep did not start");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        assert!(Command::new("kill")
+            .args(["-TERM", &pid.to_string()])
+            .status()
+            .unwrap()
+            .success());
+    });
+    let err: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert!(!status.success(), "SIGTERM did not stop the sweep");
+    assert!(
+        err.iter().any(|l| l.contains("interrupted")),
+        "{}",
+        err.join("\n")
+    );
+    assert!(journalled(&stopped_out) < 14, "the sweep was not cut short");
 }

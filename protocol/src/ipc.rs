@@ -98,6 +98,13 @@ pub fn ipc_root_dir() -> Result<PathBuf, IpcSetupError> {
     Ok(dir)
 }
 
+/// Exit status of a worker that left while it waited for an answer,
+/// having concluded that the coordinator was gone. Such a worker held no
+/// case: one the coordinator had sent it was never started, so the
+/// coordinator hands it back without charging it an attempt (#33 item 3: a
+/// healthy case was failed for two workers that left this way).
+pub const EXIT_LEFT_WAITING: u8 = 3;
+
 /// How often at most a worker beats while it computes (a few times a
 /// second: enough to tell a long computation from a hang within a second).
 pub const HEARTBEAT_INTERVAL: std::time::Duration = std::time::Duration::from_millis(250);

@@ -40,7 +40,7 @@ mod wire;
 pub use ipc::{
     coord_node_name, create_node, event_service_port, heartbeat_path, ipc_config, ipc_root_dir,
     node_alive, read_heartbeat, to_coord_event, to_workers_event, work_service, work_service_port,
-    worker_node_name, write_heartbeat, EventService, IpcSetupError, WorkService,
+    worker_node_name, write_heartbeat, EventService, IpcSetupError, WorkService, EXIT_LEFT_WAITING,
     HEARTBEAT_INTERVAL, IPC_PREFIX, IPC_PREFIX_ENV, PORT_SLACK,
 };
 pub use messages::{

@@ -23,7 +23,9 @@ def main(argv=None):
         sys.exit(f"usage: worker --run RUN --index K (got {' '.join(args)})")
     from mpcontact import _native
 
-    _native.worker(args[2], int(args[4]))
+    # The exit status tells the coordinator how the worker ended (as the
+    # CLI's `mpcontact worker` does): 3 = left while waiting, holding no case.
+    sys.exit(_native.worker(args[2], int(args[4])))
 
 
 if __name__ == "__main__":

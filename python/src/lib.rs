@@ -548,13 +548,20 @@ impl Drop for SavedSignals {
 }
 
 /// The worker process of a sweep (`mpcontact worker`), hosted by Python:
-/// `worker::run_worker` with the CLI's case key. Returns when the
-/// coordinator says it is done or is gone.
+/// `worker::run_worker` with the CLI's case key. Returns the exit status
+/// the worker process should end with (as `mpcontact worker` does): 0 when
+/// the coordinator said it is done, `worker::EXIT_LEFT_WAITING` when it
+/// looked gone while the worker waited (so the worker held no case).
 #[pyfunction]
 #[pyo3(name = "worker")]
-fn serve_as_worker(py: Python<'_>, run: String, index: usize) -> PyResult<()> {
-    py.detach(move || ::worker::run_worker::<coordinator::case::CaseKey>(&run, index))
-        .map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))
+fn serve_as_worker(py: Python<'_>, run: String, index: usize) -> PyResult<u8> {
+    let end = py
+        .detach(move || ::worker::run_worker::<coordinator::case::CaseKey>(&run, index))
+        .map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))?;
+    Ok(match end {
+        ::worker::WorkerEnd::Done => 0,
+        ::worker::WorkerEnd::CoordinatorGone => ::worker::EXIT_LEFT_WAITING,
+    })
 }
 
 /// The module.

@@ -23,7 +23,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use anyhow::{anyhow, bail, Context};
 use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
-use iceoryx2::port::listener::Listener;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use protocol::{
@@ -111,11 +111,24 @@ enum Answer<K> {
 /// logged then), so the one check that can be transient is repeated.
 const UNLISTED_CHECKS: u32 = 3;
 
+pub use protocol::EXIT_LEFT_WAITING;
+
+/// How a worker's service ended (when it did not fail).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorkerEnd {
+    /// The coordinator said `Done`.
+    Done,
+    /// The coordinator looked gone while this worker waited for an answer
+    /// (so it held no case); its process should exit with
+    /// [`protocol::EXIT_LEFT_WAITING`].
+    CoordinatorGone,
+}
+
 /// Attach to run `run_id` as worker `worker_index`, solve cases until the
 /// coordinator says `Done` (or disappears), then detach. Returns an error
 /// only when attaching fails or the coordinator rejects this worker. `K` is
 /// the coordinator's case key type.
-pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Result<()> {
+pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Result<WorkerEnd> {
     let w = attach(run_id, worker_index)?;
     // The solver's loops beat for this worker while it computes.
     let heartbeat = std::rc::Rc::new(std::cell::RefCell::new(heartbeat::Heartbeat::open(
@@ -142,9 +155,9 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
                 eprintln!(
                     "worker {worker_index}: coordinator of run {run_id} is gone ({why}); exiting"
                 );
-                return Ok(());
+                return Ok(WorkerEnd::CoordinatorGone);
             }
-            Ok(ToWorker::Done) => return Ok(()),
+            Ok(ToWorker::Done) => return Ok(WorkerEnd::Done),
             Ok(ToWorker::Rejected { reason }) => {
                 bail!("worker {worker_index}: rejected by the coordinator: {reason}")
             }
@@ -163,6 +176,21 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
 
 #[cfg(feature = "fault-injection")]
 pub mod fault_injection;
+
+/// Test hook (fault injection): how long the coordinator's journal should
+/// sleep after each sync to play a slow disk
+/// (`fault_injection::JOURNAL_SYNC_DELAY_ENV`). Always `None` in a build
+/// without the `fault-injection` feature, so a shipped binary has no hook.
+pub fn test_journal_sync_delay() -> Option<Duration> {
+    #[cfg(feature = "fault-injection")]
+    {
+        fault_injection::journal_sync_delay()
+    }
+    #[cfg(not(feature = "fault-injection"))]
+    {
+        None
+    }
+}
 
 fn solve_one<K: WireKey>(
     case: &CaseAssignment<K, WireSpec>,
@@ -311,33 +339,57 @@ impl Attached {
     }
 
     /// Wait for the coordinator's answer to `pending`, checking on every
-    /// timeout that the coordinator is still there.
+    /// timeout that the coordinator is still there. Only the absence of an
+    /// answer is evidence: a busy coordinator may answer late (a journal on
+    /// a slow disk made it 0.6 s: two results at 300 ms per sync before the
+    /// wake-up, #33), and it closes a request right after answering it.
     fn wait_answer<K: WireKey>(&self, pending: &Pending) -> anyhow::Result<Answer<K>> {
         let mut unlisted = 0;
         loop {
-            if let Some(response) = pending
-                .receive()
-                .map_err(|e| anyhow!("cannot receive response: {e:?}"))?
-            {
-                let decoded =
-                    protocol::decode_to_worker::<K, WireSpec>(response.payload(), &self.run_id)
-                        .context("malformed message from the coordinator")?;
-                return Ok(Answer::Message(Box::new(decoded.header.body)));
+            if let Some(m) = self.take_answer(pending)? {
+                return Ok(Answer::Message(m));
             }
-            let woke = self
-                .listener
-                .timed_wait(|_| {}, WAIT_PERIOD)
-                .map_err(|e| anyhow!("waiting for the coordinator failed: {e:?}"))?;
+            let woke = match self.listener.timed_wait(|_| {}, WAIT_PERIOD) {
+                Ok(n) => n,
+                // A signal cut the wait short (a stopped job resumed with
+                // SIGCONT, #33 item 4): not a timeout, just look again.
+                Err(ListenerWaitError::InterruptSignal) => continue,
+                Err(e) => bail!("waiting for the coordinator failed: {e:?}"),
+            };
             if woke == 0 {
                 if let Some(why) = self.coordinator_gone(pending, &mut unlisted) {
+                    // The coordinator sends its answer before it closes the
+                    // request, so an answer that arrived after the last look
+                    // is still waiting here: #33 item 3 lost five healthy
+                    // workers, each with its next case unread in this buffer.
+                    if let Some(m) = self.take_answer(pending)? {
+                        return Ok(Answer::Message(m));
+                    }
                     return Ok(Answer::CoordinatorGone(why));
                 }
             }
         }
     }
 
+    /// The coordinator's answer to `pending`, if one has arrived.
+    fn take_answer<K: WireKey>(
+        &self,
+        pending: &Pending,
+    ) -> anyhow::Result<Option<Box<CoordMessage<K>>>> {
+        let Some(response) = pending
+            .receive()
+            .map_err(|e| anyhow!("cannot receive response: {e:?}"))?
+        else {
+            return Ok(None);
+        };
+        let decoded = protocol::decode_to_worker::<K, WireSpec>(response.payload(), &self.run_id)
+            .context("malformed message from the coordinator")?;
+        Ok(Some(Box::new(decoded.header.body)))
+    }
+
     /// Why the coordinator is gone, or None while it may still answer. A
-    /// dropped request or a node listed dead are final; a node missing from
+    /// request it closed (the caller then looks for an answer once more) or
+    /// a node listed dead are final; a node missing from
     /// the list only after `UNLISTED_CHECKS` checks in a row (`unlisted`
     /// counts them): one missing listing is not taken as proof. The reason
     /// goes into the worker's log, so that a false "gone" can be traced.

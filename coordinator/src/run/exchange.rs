@@ -121,7 +121,8 @@ impl<'a> Exchange<'a> {
 
     /// Wake on every worker notification and at least every `tick`, calling
     /// `step` each time until it returns `true`. A termination request
-    /// (Ctrl-C, SIGTERM) ends the loop with an error.
+    /// (Ctrl-C, SIGTERM) ends the loop with an error; other signals (a
+    /// pause and resume) do not.
     pub fn wait_loop(
         &self,
         tick: Duration,
@@ -138,9 +139,12 @@ impl<'a> Exchange<'a> {
             .map_err(|e| anyhow!("cannot attach interval: {e:?}"))?;
         loop {
             match waitset.wait_and_process_once(|_| CallbackProgression::Continue) {
-                Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    return Err(Interrupted.into())
-                }
+                Ok(WaitSetRunResult::TerminationRequest) => return Err(Interrupted.into()),
+                // Any other signal cut the wait short: SIGCONT after a pause
+                // (Ctrl-Z and `fg`, a debugger, `scontrol suspend`/`resume`)
+                // ended a sweep here (#33 item 4). Not a request to stop: go
+                // on. A SIGINT or SIGTERM that cut it short is seen as a
+                // termination request by the next wait, which checks first.
                 Ok(_) => {}
                 Err(e) => bail!("waiting failed: {e:?}"),
             }

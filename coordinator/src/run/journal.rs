@@ -97,6 +97,9 @@ pub enum Line {
 pub struct Journal {
     file: File,
     path: PathBuf,
+    /// Test hook (fault injection, tests only): sleep this long after each
+    /// sync, as on a slow disk; see `worker::test_journal_sync_delay`.
+    test_sync_delay: Option<std::time::Duration>,
 }
 
 /// What a previous run left in the journal.
@@ -204,6 +207,7 @@ impl Journal {
             let mut j = Journal {
                 file: OpenOptions::new().append(true).open(&path)?,
                 path,
+                test_sync_delay: worker::test_journal_sync_delay(),
             };
             if good_len == 0 {
                 j.append(&Line::Header {
@@ -219,7 +223,11 @@ impl Journal {
             .append(true)
             .open(&path)
             .with_context(|| format!("while creating {}", path.display()))?;
-        let mut j = Journal { file, path };
+        let mut j = Journal {
+            file,
+            path,
+            test_sync_delay: worker::test_journal_sync_delay(),
+        };
         j.append(&Line::Header {
             run_id: run_id.to_string(),
             config: config.to_string(),
@@ -235,7 +243,11 @@ impl Journal {
         self.file
             .write_all(text.as_bytes())
             .and_then(|_| self.file.sync_data())
-            .with_context(|| format!("while appending to {}", self.path.display()))
+            .with_context(|| format!("while appending to {}", self.path.display()))?;
+        if let Some(delay) = self.test_sync_delay {
+            std::thread::sleep(delay);
+        }
+        Ok(())
     }
 
     /// The config text of a journal's header line.

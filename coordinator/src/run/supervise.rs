@@ -63,7 +63,20 @@ pub struct Supervisor<'a> {
     children: BTreeMap<usize, Child>,
     next_index: usize,
     spawns_left: usize,
+    /// When the previous survey was taken.
+    last_survey: Option<Instant>,
+    /// When this coordinator last came back from a stall (see
+    /// [`STALL_GAP`]); silence before it is not counted against workers.
+    resumed_at: Option<Instant>,
 }
+
+/// A gap between two surveys (normally one 0.5 s tick apart) longer than
+/// this means this coordinator did not run: the run was paused (SIGSTOP,
+/// `scontrol suspend`, whose pause stops workers too) or the machine starved
+/// it. Workers' heartbeats are as old as the pause then, so silence is
+/// counted from the resumption: a suspended job resumed after more than
+/// `run.case_timeout_s` would otherwise see every busy worker killed as hung.
+const STALL_GAP: Duration = Duration::from_secs(2);
 
 /// Which worker nodes of the system were alive at one listing.
 pub struct NodeSurvey {
@@ -99,6 +112,8 @@ impl<'a> Supervisor<'a> {
             args,
             children: BTreeMap::new(),
             next_index: 0,
+            last_survey: None,
+            resumed_at: None,
         }
     }
 
@@ -161,6 +176,18 @@ impl<'a> Supervisor<'a> {
             .map(|c| matches!(c.try_wait(), Ok(Some(_))))
     }
 
+    /// Whether worker `k` is ours and exited with
+    /// [`protocol::EXIT_LEFT_WAITING`]: it left while waiting for an
+    /// answer, so it held no case (whatever was sent to it went unread).
+    pub fn left_waiting(&mut self, k: usize) -> bool {
+        use std::os::unix::process::ExitStatusExt;
+        self.children.get_mut(&k).is_some_and(|c| {
+            matches!(c.try_wait(), Ok(Some(st))
+                if st.signal().is_none()
+                    && st.code() == Some(i32::from(protocol::EXIT_LEFT_WAITING)))
+        })
+    }
+
     /// Kill worker `k` if it is ours, and reap it.
     pub fn stop(&mut self, k: usize) {
         if let Some(mut c) = self.children.remove(&k) {
@@ -176,8 +203,17 @@ impl<'a> Supervisor<'a> {
         }
     }
 
-    /// List the nodes of the system (and clean up after dead ones).
-    pub fn survey(&self, exchange: &Exchange) -> NodeSurvey {
+    /// List the nodes of the system (and clean up after dead ones); notes a
+    /// stall of this coordinator since the previous survey.
+    pub fn survey(&mut self, exchange: &Exchange) -> NodeSurvey {
+        let now = Instant::now();
+        if self
+            .last_survey
+            .is_some_and(|t| now.duration_since(t) > STALL_GAP)
+        {
+            self.resumed_at = Some(now);
+        }
+        self.last_survey = Some(now);
         let mut alive: HashMap<String, bool> = HashMap::new();
         let mut saw_dead = false;
         let listed = Node::<ipc::Service>::list(exchange.config(), |st| {
@@ -218,7 +254,8 @@ impl<'a> Supervisor<'a> {
     /// Judge worker `k`: `registered` when it has sent a message (only then
     /// is a missing node meaningful), `in_flight_for` how long its case has
     /// been in flight to it. Silence is counted from the later of the
-    /// dispatch and the worker's last heartbeat.
+    /// dispatch, the worker's last heartbeat and this coordinator's return
+    /// from a stall.
     pub fn verdict(
         &mut self,
         k: usize,
@@ -229,6 +266,7 @@ impl<'a> Supervisor<'a> {
         let deadline = self.case_deadline();
         if let Some(took) = in_flight_for {
             let silent = self.since_heartbeat(k).map_or(took, |b| b.min(took));
+            let silent = self.resumed_at.map_or(silent, |r| silent.min(r.elapsed()));
             if silent > deadline {
                 return Verdict::Hung {
                     took,
@@ -264,5 +302,46 @@ impl<'a> Supervisor<'a> {
             }
             let _ = c.wait();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A worker that exits with `protocol::EXIT_LEFT_WAITING` is told apart
+    /// from one that ended otherwise (#33 item 3: its case is not charged).
+    #[test]
+    fn issue33_item3_a_worker_that_left_waiting_is_told_by_its_exit_status() {
+        let out = tempfile::Builder::new()
+            .prefix("mpc-left-")
+            .tempdir()
+            .unwrap();
+        let status_of = |code: &str| {
+            // `sh -c SCRIPT worker --run …`: the worker's arguments become
+            // the script's $0…, and the script only exits.
+            let exe = WorkerCommand {
+                program: "/bin/sh".into(),
+                args: vec!["-c".into(), format!("exit {code}")],
+                arg0: None,
+            };
+            let mut sup = Supervisor::new(SuperviseArgs {
+                run_id: "mpc-left-test",
+                exe: &exe,
+                out_dir: out.path(),
+                workers: 1,
+                case_timeout: Duration::from_secs(60),
+            });
+            let k = sup.spawn().unwrap();
+            let t = Instant::now();
+            while sup.exited(k) != Some(true) {
+                assert!(t.elapsed() < Duration::from_secs(30), "sh did not exit");
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            sup.left_waiting(k)
+        };
+        assert!(status_of(&protocol::EXIT_LEFT_WAITING.to_string()));
+        assert!(!status_of("0"));
+        assert!(!status_of("2"));
     }
 }
