@@ -139,7 +139,15 @@ fn journal_cases(out: &Path) -> Vec<serde_json::Value> {
 #[test]
 fn two_workers_record_every_case_once_reuse_kernels_and_leave_no_shm() {
     let dir = scratch("two");
-    let out = sweep_cmd(&dir, "out", 2, "a").output().unwrap();
+    // Both workers must get cases, but 12 cases of 32² take milliseconds:
+    // on a loaded machine worker 0 finished them all before worker 1 had
+    // attached ("one worker idled", #15, #33 item 5). A journal synced in
+    // 250 ms (test hook) stretches the sweep to at least 3 s, time enough
+    // for any worker to attach; what is checked is unchanged.
+    let out = sweep_cmd(&dir, "out", 2, "a")
+        .env(JOURNAL_SYNC_DELAY_ENV, "250")
+        .output()
+        .unwrap();
     check_ok(&out, "2-worker sweep");
     let o = dir.join("out");
 
@@ -798,7 +806,10 @@ fn issue20_item12_a_replacement_worker_runs_the_same_build() {
 /// #20 item 4: a case that computes far longer than `run.case_timeout_s`
 /// is not taken for a hang: the worker beats while it computes. (The old
 /// deadline, max(timeout, 10 × longest case so far), killed the first long
-/// case twice and journalled it failed.)
+/// case twice and journalled it failed.) The limit is 1 s, not 0.5 s: a
+/// worker starved by other processes (tests at `nice 19` beside a sweep)
+/// went more than 0.5 s between beats twice (#15, #33 item 5); each case
+/// must still compute at least twice the limit, as before.
 #[test]
 fn issue20_item4_a_long_computation_is_not_a_hang() {
     let dir = scratch("long");
@@ -821,7 +832,7 @@ surfaces = ["flat"]
 angles_deg = [0.0, 90.0]
 
 [run]
-case_timeout_s = 0.5
+case_timeout_s = 1.0
 "#;
     std::fs::write(dir.join("sweep.toml"), config).unwrap();
     let out = sweep_cmd(&dir, "out", 1, "l").output().unwrap();
@@ -834,7 +845,7 @@ case_timeout_s = 0.5
     for row in &rows[1..] {
         assert_eq!(row[col("status")], "ok", "{row:?}");
         let seconds: f64 = row[col("seconds")].parse().unwrap();
-        assert!(seconds > 1.0, "the case was not long: {seconds} s");
+        assert!(seconds > 2.0, "the case was not long: {seconds} s");
     }
 }
 
