@@ -34,11 +34,17 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         .map(worker::kernel_store::FileStore::new);
     let mut kernels: BTreeMap<KernelKey, (String, bool, bool, usize)> = BTreeMap::new();
     for (key, spec) in &cases {
-        let persistent = spec.material.model().persist_tables();
+        let persistent = solver::persists(spec);
         if let std::collections::btree_map::Entry::Vacant(slot) = kernels.entry(KernelKey::of(spec))
         {
             let cached = persistent && store.as_ref().is_some_and(|s| s.holds(slot.key()));
-            slot.insert((key.material.clone(), persistent, cached, spec.grid.n));
+            // The pair a kernel is made for: the substrate, and the ball when
+            // it is elastic.
+            let bodies = match &spec.indenter {
+                Some(ball) => format!("{} + ball {}", key.material, ball.name),
+                None => key.material.clone(),
+            };
+            slot.insert((bodies, persistent, cached, spec.grid.n));
         }
     }
     let per_worker = crate::memory::worker_bytes(n, kernels.len());
@@ -67,6 +73,8 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         let _ = writeln!(s, "ladder:    {levels} levels: {}", sizes.join(", "));
     }
     let list = |v: &[String]| v.join(", ");
+    let ball = config.indenter.material.as_deref().unwrap_or("rigid");
+    let _ = writeln!(s, "indenter:  R = {} mm, {ball}", config.indenter.radius_mm);
     let _ = writeln!(
         s,
         "materials: {} ({})",

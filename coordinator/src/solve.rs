@@ -19,6 +19,8 @@ use std::path::Path;
 #[derive(Serialize)]
 pub struct CaseJson<'a> {
     material: &'a str,
+    /// The ball's material, or `rigid`.
+    indenter: &'a str,
     surface: &'a str,
     angle_deg: f64,
     status: Status,
@@ -149,6 +151,11 @@ impl Solved {
         let h = self.scalars.history.as_ref();
         CaseJson {
             material: &c.material,
+            indenter: c
+                .spec
+                .indenter
+                .as_ref()
+                .map_or("rigid", |m| m.name.as_str()),
             surface: &c.surface,
             angle_deg: c.angle_deg,
             status: Status::of_solved(self.scalars.converged),

@@ -265,6 +265,7 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
             max_coupling_iterations: 50,
         },
         history: None,
+        indenter: None,
     };
     let mut cache = KernelCache::new();
     cache.set_threads(threads.clone());

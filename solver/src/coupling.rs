@@ -175,7 +175,7 @@ pub(crate) fn solve_step(
     normal0: NormalSolution,
     step: &Step,
 ) -> Result<ContactState, SolverError> {
-    let num = spec.numerics;
+    let num = spec.numerics_in_effect();
     let grid = spec.grid;
     let len = grid.len();
     let da = grid.cell_area();

@@ -120,7 +120,7 @@ pub(crate) fn solve_history(
 ) -> Result<HistoryState, SolverError> {
     let grid = spec.grid;
     let (len, da) = (grid.len(), grid.cell_area());
-    let num = spec.numerics;
+    let num = spec.numerics_in_effect();
     let mu = spec.load.friction;
     let angle = spec.load.angle_deg.to_radians();
     let dir = [angle.cos(), angle.sin()];

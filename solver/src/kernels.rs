@@ -27,15 +27,23 @@ pub struct KernelKey(String);
 impl KernelKey {
     /// The kernel a case needs.
     pub fn of(spec: &CaseSpec) -> Self {
-        let c = spec.material.stiffness();
-        let consts: Vec<String> = c.iter().map(|v| format!("{v:.9e}")).collect();
-        KernelKey(format!(
+        let consts = |m: &Material| {
+            let c: Vec<String> = m.stiffness().iter().map(|v| format!("{v:.9e}")).collect();
+            c.join(",")
+        };
+        let mut key = format!(
             "{}|{}|{:.9e}|{}",
             spec.material.name,
             spec.grid.n,
             spec.grid.dx,
-            consts.join(",")
-        ))
+            consts(&spec.material)
+        );
+        // An elastic ball makes another kernel; a rigid one keeps the key
+        // (and the stored kernels) of before balls existed.
+        if let Some(ball) = &spec.indenter {
+            key.push_str(&format!("|ball {}|{}", ball.name, consts(ball)));
+        }
+        KernelKey(key)
     }
 
     /// The key as text (what a store writes and compares).
@@ -86,12 +94,44 @@ const LOCK_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 /// [`Operator::build`]); from one quadrant of offsets when the material's
 /// influence is mirror symmetric (see [`Operator::build_mirrored`]).
 pub fn build_operator(material: &Material, grid: Grid) -> Operator {
+    build_pair_operator(material, None, grid)
+}
+
+/// The operator of a substrate pressed by a ball of material `indenter`
+/// (`None`: rigid, [`build_operator`]): the two bodies' compliances summed
+/// ([`crate::material::pair_influence`]); mirrored from one quadrant when
+/// both influences are mirror symmetric (R K(x, −y) R keeps the parities).
+pub fn build_pair_operator(
+    material: &Material,
+    indenter: Option<&Material>,
+    grid: Grid,
+) -> Operator {
     let model = material.model();
-    if model.mirror_symmetric() {
-        Operator::build_mirrored(grid, model.cell_influence(grid))
+    let (influence, mirror) = match indenter {
+        None => (model.cell_influence(grid), model.mirror_symmetric()),
+        Some(ball) => (
+            crate::material::pair_influence(
+                model.cell_influence(grid),
+                ball.model().cell_influence(grid),
+            ),
+            model.mirror_symmetric() && ball.model().mirror_symmetric(),
+        ),
+    };
+    if mirror {
+        Operator::build_mirrored(grid, influence)
     } else {
-        Operator::build(grid, model.cell_influence(grid))
+        Operator::build(grid, influence)
     }
+}
+
+/// True when a case's kernel is expensive enough to persist (a numerical
+/// Green's function on either body).
+pub fn persists(spec: &CaseSpec) -> bool {
+    spec.material.model().persist_tables()
+        || spec
+            .indenter
+            .as_ref()
+            .is_some_and(|m| m.model().persist_tables())
 }
 
 /// What a process keeps per kernel: the DC-FFT operator and the caches the
@@ -204,7 +244,7 @@ impl KernelCache {
             let start = std::time::Instant::now();
             let grid = spec.grid;
             let len = Spectra::len_for(grid.n);
-            let persistent = spec.material.model().persist_tables();
+            let persistent = persists(spec);
             let load = |store: &dyn KernelStore| {
                 store
                     .load(&key, len)
@@ -241,7 +281,7 @@ impl KernelCache {
                     op
                 }
                 None => {
-                    let mut op = build_operator(&spec.material, grid);
+                    let mut op = build_pair_operator(&spec.material, spec.indenter.as_ref(), grid);
                     if let (Some(store), true) = (&self.store, persistent) {
                         op.with_spectra(|s| store.save(&key, s));
                     }

@@ -24,6 +24,7 @@
 //!     },
 //!     numerics: Numerics::default(),
 //!     history: None,
+//!     indenter: None,
 //! };
 //! let mut cache = KernelCache::new(); // keeps the kernel for the next case
 //! let out = solve_case(&spec, &mut cache).unwrap();
@@ -86,8 +87,13 @@ pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
 pub use history::{HistoryOutput, HistoryStep, DISSIPATION_DEFINITION};
-pub use kernels::{build_operator, BuildLock, KernelCache, KernelKey, KernelStore, Resident};
-pub use material::{hill_average, Anisotropic, ElasticModel, Elasticity, Isotropic, Material};
+pub use kernels::{
+    build_operator, build_pair_operator, persists, BuildLock, KernelCache, KernelKey, KernelStore,
+    Resident,
+};
+pub use material::{
+    hill_average, pair_influence, Anisotropic, ElasticModel, Elasticity, Isotropic, Material,
+};
 pub use operator::{Operator, Spectra};
 pub use parallel::Threads;
 pub use progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};

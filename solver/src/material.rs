@@ -291,6 +291,32 @@ impl Material {
     }
 }
 
+/// The cell influence of a contact pair: the relative displacement of the
+/// substrate's surface against the ball's, `u_sub − u_ball`, per unit traction
+/// on the substrate (the ball carries the opposite traction).
+///
+/// The ball's own frame is the substrate's turned 180° about x,
+/// `R = diag(1, −1, −1)` (its normal points into the ball, its x along the
+/// substrate's x). A traction `t` on the substrate is `−t` on the ball, which
+/// is `−R t` in the ball's frame, and the ball's displacement there at
+/// `(x, −y)` is turned back by `R`: `u_ball = −R K_ball(x, −y) R t`. So
+///
+/// `K_pair(x, y) = K_sub(x, y) + R K_ball(x, −y) R`:
+///
+/// normal–normal and tangential–tangential compliances add, the
+/// normal–tangential entries of the ball enter with the opposite sign (for
+/// isotropic bodies `K_xz(x, −y) = K_xz(x, y)`, negated by R), so two
+/// identical isotropic bodies give zero coupling (Dundurs β = 0).
+pub fn pair_influence(substrate: CellInfluence, ball: CellInfluence) -> CellInfluence {
+    // R K R flips the sign of the entries with exactly one index in {y, z}.
+    const SIGN: [[f64; 3]; 3] = [[1.0, -1.0, -1.0], [-1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]];
+    Box::new(move |x, y| {
+        let a = substrate(x, y);
+        let b = ball(x, -y);
+        std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] + SIGN[i][j] * b[i][j]))
+    })
+}
+
 /// Checks that a stiffness is finite, symmetric and positive definite; the message says what fails.
 fn check_stiffness(c: &Matrix6<f64>) -> Result<(), String> {
     crate::aniso::crystal::check_positive_definite(c)

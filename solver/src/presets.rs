@@ -38,6 +38,12 @@ pub fn materials() -> Vec<Material> {
         crystal(Table2Material::Fe111, 220.41, 0.391),
         crystal(Table2Material::Cu111, 128.53, 0.503),
         crystal(Table2Material::Ni111, 227.34, 0.423),
+        // Ball materials of tribometers (`indenter.material`): typical
+        // handbook values, not the paper's.
+        iso("steel", 210.0, 0.3),
+        iso("WC", 614.0, 0.22),
+        iso("Al2O3", 370.0, 0.22),
+        iso("glass", 70.0, 0.22),
     ]
 }
 
@@ -49,6 +55,10 @@ pub fn material_source(name: &str) -> &'static str {
         "Fe(111)" | "Cu(111)" | "Ni(111)" => {
             "paper Table 2: stiffness in the (111) frame; E, ν of Table 1 (normalisation only)"
         }
+        "steel" => "ball: bearing steel (AISI 52100), typical E, ν",
+        "WC" => "ball: cemented tungsten carbide (WC-6Co), typical E, ν",
+        "Al2O3" => "ball: alumina (99.5 %), typical E, ν",
+        "glass" => "ball: soda-lime glass, typical E, ν",
         _ => "",
     }
 }

@@ -186,6 +186,7 @@ mod tests {
             },
             numerics: crate::Numerics::default(),
             history: None,
+            indenter: None,
         }
     }
 

@@ -319,9 +319,8 @@ pub(crate) fn reduce(
     let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let base_contact = !matches!(spec.surface, crate::surface::Surface::Flat)
         && (0..len).any(|i| contact[i] && heights[i] < top);
-    let eq = spec.material.equivalent;
     let hertz_radius =
-        (3.0 * load * spec.load.indenter_radius_m / (4.0 * eq.plane_strain())).cbrt();
+        (3.0 * load * spec.load.indenter_radius_m / (4.0 * spec.contact_modulus())).cbrt();
     // Sub-cell radii: p falls to zero like the root of the distance at a
     // Hertzian edge, and μp − |q| does at a Mindlin stick edge.
     let friction = spec.load.friction;
@@ -353,9 +352,9 @@ pub(crate) fn reduce(
         stick_area_m2: stick_area,
         base_contact,
         mu_a: None,
-        k_e: eq.mindlin_k_e(),
+        k_e: spec.mindlin_k_e(),
         mu_a_cells: None,
-        k_e_cells: eq.mindlin_k_e(),
+        k_e_cells: spec.mindlin_k_e(),
         k_e_source: K_E_ISOTROPIC.into(),
         hertz_radius_m: hertz_radius,
         hertz_pressure_pa: 3.0 * load / (2.0 * std::f64::consts::PI * hertz_radius * hertz_radius),

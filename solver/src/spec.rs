@@ -5,7 +5,7 @@
 
 use crate::error::SolverError;
 use crate::grid::Grid;
-use crate::material::Material;
+use crate::material::{Elasticity, Material};
 use crate::surface::Surface;
 use serde::{Deserialize, Serialize};
 
@@ -205,6 +205,13 @@ pub struct CaseSpec {
     /// step of the tangential force from zero at constant normal load.
     #[serde(default)]
     pub history: Option<LoadHistory>,
+    /// The ball's material, its stiffness in the ball's own frame (normal
+    /// pointing into the ball, x along the substrate's x, y = z × x, i.e.
+    /// the substrate's frame turned 180° about x); `None`: a rigid ball.
+    /// The contact compliance is the sum of the two bodies' (see
+    /// [`crate::material::pair_influence`]).
+    #[serde(default)]
+    pub indenter: Option<Material>,
 }
 
 fn positive(param: &str, v: f64, what: &str) -> Result<(), SolverError> {
@@ -228,9 +235,58 @@ impl CaseSpec {
     }
 
     /// True when μa needs K_E calibrated on the flat surface of the same
-    /// material at the same angle (anisotropic material under a tangential load).
+    /// material at the same angle (an anisotropic substrate or ball under a
+    /// tangential load).
     pub fn needs_flat_calibration(&self) -> bool {
-        !self.material.is_isotropic() && self.load.tangential_ratio > 0.0
+        let anisotropic = !self.material.is_isotropic()
+            || self.indenter.as_ref().is_some_and(|m| !m.is_isotropic());
+        anisotropic && self.load.tangential_ratio > 0.0
+    }
+
+    /// The solver settings as solved: with coupling off when the pair's
+    /// normal–tangential coupling vanishes identically (an elastic ball of
+    /// the substrate's own isotropic constants, Dundurs β = 0, or two
+    /// incompressible isotropic bodies), where the coupling loop could only
+    /// repeat its first pass. A rigid ball keeps the settings as given.
+    pub fn numerics_in_effect(&self) -> Numerics {
+        let mut num = self.numerics;
+        if let (Some(ball), Elasticity::Isotropic(sub)) =
+            (&self.indenter, &self.material.elasticity)
+        {
+            if let Elasticity::Isotropic(b) = &ball.elasticity {
+                let identical = sub.youngs == b.youngs && sub.poisson == b.poisson;
+                let incompressible = sub.poisson == 0.5 && b.poisson == 0.5;
+                if identical || incompressible {
+                    num.coupling = false;
+                }
+            }
+        }
+        num
+    }
+
+    /// The contact modulus E* of the pair from the isotropic-equivalent
+    /// constants, `1/E* = Σ (1 − νᵢ²)/Eᵢ` (the substrate's plane-strain
+    /// modulus for a rigid ball): Hertz normalisation.
+    pub fn contact_modulus(&self) -> f64 {
+        let sub = self.material.equivalent.plane_strain();
+        match &self.indenter {
+            // As before balls existed (1/(1/E*) may differ from E* in the last bit).
+            None => sub,
+            Some(ball) => 1.0 / (1.0 / sub + 1.0 / ball.equivalent.plane_strain()),
+        }
+    }
+
+    /// Mindlin's K_E of the pair, `16 / (3 Σ (2 − νᵢ)/Gᵢ)` from the
+    /// isotropic-equivalent constants (the substrate's
+    /// `8E / (3(1 + ν)(2 − ν))` for a rigid ball, computed as before).
+    pub fn mindlin_k_e(&self) -> f64 {
+        match &self.indenter {
+            None => self.material.equivalent.mindlin_k_e(),
+            Some(ball) => {
+                let c = |m: &Material| (2.0 - m.equivalent.poisson) / m.equivalent.shear();
+                16.0 / (3.0 * (c(&self.material) + c(ball)))
+            }
+        }
     }
 
     /// The same case on the flat surface: the K_E calibration twin.
@@ -357,6 +413,9 @@ impl CaseSpec {
         self.material
             .validate()
             .map_err(|e| within("material", e))?;
+        if let Some(ball) = &self.indenter {
+            ball.validate().map_err(|e| within("indenter", e))?;
+        }
         self.surface
             .validate(grid.n)
             .map_err(|e| within("surface", e))?;
@@ -377,9 +436,8 @@ impl CaseSpec {
                 ));
             }
         }
-        let a_hertz = (3.0 * normal_min * load.indenter_radius_m
-            / (4.0 * self.material.equivalent.plane_strain()))
-        .cbrt();
+        let a_hertz =
+            (3.0 * normal_min * load.indenter_radius_m / (4.0 * self.contact_modulus())).cbrt();
         let min = MIN_RESOLVED_CELLS * grid.dx;
         if a_hertz < min {
             return Err(SolverError::ContactUnresolved {

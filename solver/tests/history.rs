@@ -278,6 +278,7 @@ fn quick_fretting(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
             normal_forces_n: None,
             steps_per_segment: 10,
         }),
+        indenter: None,
     }
 }
 

@@ -23,6 +23,7 @@ fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64
             ..Numerics::default()
         },
         history: None,
+        indenter: None,
     }
 }
 

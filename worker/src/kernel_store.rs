@@ -409,6 +409,7 @@ mod tests {
                 max_coupling_iterations: 5,
             },
             history: None,
+            indenter: None,
         }
     }
 

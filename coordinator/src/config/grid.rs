@@ -22,6 +22,11 @@ pub struct GridCfg {
 pub struct IndenterCfg {
     /// Sphere radius, mm.
     pub radius_mm: f64,
+    /// The ball's material (a preset or a `[materials.NAME]` table), in the
+    /// ball's own frame; absent: a rigid ball. Not written back when absent,
+    /// so that a rigid-ball config echoes (and resumes) as before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
 }
 
 /// `[load]`

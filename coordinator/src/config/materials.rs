@@ -63,11 +63,25 @@ pub(super) fn material_key<'a>(param: &'a str, cfg: Option<&MaterialCfg>) -> &'a
 impl Config {
     /// Resolves a material name: `[materials.NAME]` first, then presets.
     pub fn material(&self, name: &str) -> Result<Material> {
+        self.material_for("sweep.materials", name)
+    }
+
+    /// The ball's material (`indenter.material`), `None` for a rigid ball.
+    pub fn indenter_material(&self) -> Result<Option<Material>> {
+        self.indenter
+            .material
+            .as_deref()
+            .map(|name| self.material_for("indenter.material", name))
+            .transpose()
+    }
+
+    /// Resolves a material name given under the config key `key`.
+    fn material_for(&self, key: &str, name: &str) -> Result<Material> {
         if let Some(m) = self.materials.get(name) {
             return build_material(name, m, &|e| self.explain(within("material", e), name, ""));
         }
         solver::presets::material(name).ok_or_else(|| {
-            anyhow!("sweep.materials: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
+            anyhow!("{key}: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
         })
     }
 }

@@ -165,6 +165,12 @@ impl Config {
                 "materials.{material}.{}",
                 materials::material_key(p, self.materials.get(material))
             )
+        } else if let Some(p) = field.strip_prefix("indenter.") {
+            let ball = self.indenter.material.as_deref().unwrap_or_default();
+            format!(
+                "materials.{ball}.{}",
+                materials::material_key(p, self.materials.get(ball))
+            )
         } else if let Some(p) = field.strip_prefix("surface.") {
             format!("surfaces.{surface}.{}", surfaces::surface_key(p))
         } else {
@@ -195,17 +201,34 @@ impl Config {
 
     /// One case spec.
     pub fn spec(&self, material: &str, surface: &str, angle_deg: f64) -> Result<CaseSpec> {
-        Ok(self.spec_of(self.material(material)?, self.surface(surface)?, angle_deg))
+        Ok(self.spec_of(
+            self.material(material)?,
+            self.surface(surface)?,
+            angle_deg,
+            self.indenter_material()?,
+        ))
     }
 
     /// One case spec on a surface given directly (not by name), e.g. a
     /// [`heightmap_surface`] made from an array.
     pub fn spec_on(&self, material: &str, surface: Surface, angle_deg: f64) -> Result<CaseSpec> {
-        Ok(self.spec_of(self.material(material)?, surface, angle_deg))
+        Ok(self.spec_of(
+            self.material(material)?,
+            surface,
+            angle_deg,
+            self.indenter_material()?,
+        ))
     }
 
-    /// The spec of a resolved material and surface at one angle.
-    fn spec_of(&self, material: Material, surface: Surface, angle_deg: f64) -> CaseSpec {
+    /// The spec of a resolved material and surface at one angle, pressed by
+    /// the resolved ball `indenter` (`None`: rigid).
+    fn spec_of(
+        &self,
+        material: Material,
+        surface: Surface,
+        angle_deg: f64,
+        indenter: Option<Material>,
+    ) -> CaseSpec {
         let history = self.load_history();
         // With a load path, the case's own ratio is the path's last one (its
         // final state is reduced like a monotonic case: μa, K_E calibration).
@@ -220,6 +243,7 @@ impl Config {
             load: self.load_at(tangential_ratio, angle_deg),
             numerics: self.solver.numerics(),
             history,
+            indenter,
         }
     }
 
@@ -241,12 +265,13 @@ impl Config {
                 Ok((s, surface))
             })
             .collect::<Result<Vec<_>>>()?;
+        let indenter = self.indenter_material()?;
         let mut out = Vec::new();
         for m in &self.sweep.materials {
             let material = self.material(m)?;
             for (s, surface) in &surfaces {
                 for &a in &angles {
-                    let spec = self.spec_of(material.clone(), surface.clone(), a);
+                    let spec = self.spec_of(material.clone(), surface.clone(), a, indenter.clone());
                     let finer: Vec<_> = (1..self.convergence.levels)
                         .map(|level| {
                             let grid = self.level_grid(level);

@@ -630,6 +630,7 @@ mod tests {
             },
             numerics: super::super::plan::tests::quick_numerics(),
             history: None,
+            indenter: None,
         };
         let key = CaseKey::new("Cu(111)", surface_name, 30.0);
         let mut plan = super::super::plan::Plan::new(vec![(key, spec)]);

@@ -187,6 +187,7 @@ pub(crate) mod tests {
             },
             numerics: quick_numerics(),
             history: None,
+            indenter: None,
         }
     }
 

@@ -25,5 +25,6 @@ pub fn table_1a_fe(n: usize, spacing_um: f64, coupling: bool, ratio: f64) -> Cas
             ..Numerics::default()
         },
         history: None,
+        indenter: None,
     }
 }
