@@ -202,3 +202,32 @@ def test_a_fretting_history_equals_the_cli_table_bit_for_bit(tmp_path, cli_solve
     plain = tmp_path / "plain.toml"
     plain.write_text(mindlin_text(ratio=0.6))
     assert mpcontact.solve(mpcontact.Config.from_toml(plain)).history() is None
+
+
+def test_an_elastic_ball_from_python_equals_the_cli_and_softens_the_contact(
+    tmp_path, cli_solve
+):
+    # indenter.material (issue #35) set from Python and given in the file:
+    # the same case, bit for bit; a steel ball on Fe (its own constants)
+    # halves the contact modulus, so a grows by 2^(1/3).
+    path = tmp_path / "ball.toml"
+    path.write_text(
+        mindlin_text(ratio=0.6).replace(
+            "radius_mm = 18.0", 'radius_mm = 18.0\nmaterial = "steel"'
+        )
+    )
+    case_json, cli_dir = cli_solve(path)
+    cfg = mpcontact.Config.from_toml(path)
+    res = mpcontact.solve(cfg)
+    assert_same_as_cli(res, case_json, cli_dir)
+    assert res.scalars["indenter"] == "steel"
+    rigid = mpcontact.solve(_rigid(tmp_path))
+    ratio = res.scalars["hertz_radius_m"] / rigid.scalars["hertz_radius_m"]
+    assert ratio == pytest.approx(2 ** (1 / 3), rel=1e-12)
+    assert rigid.scalars["indenter"] == "rigid"
+
+
+def _rigid(tmp_path):
+    path = tmp_path / "rigid.toml"
+    path.write_text(mindlin_text(ratio=0.6))
+    return mpcontact.Config.from_toml(path)
