@@ -2,18 +2,20 @@
 //! definition used by the config, the plan, the journal, the outputs and
 //! `solve`. Owns no files, no IPC and no physics.
 //!
-//! The key's `Display` text (`Cu/flat/015.0`) is for people (progress lines,
-//! logs, `fields/<case>/`, the journal's `case_id`); nothing parses it back.
+//! The key's `Display` text (`Cu/flat/015.0`, `Cu/flat/015.0@steel` in a
+//! sweep over balls) is for people (progress lines, logs, `fields/<case>/`,
+//! the journal's `case_id`); nothing parses it back.
 
 use std::fmt;
 
+use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
 
 /// Which case of a sweep: material × surface × force angle, by the names
-/// the config uses, and the grid level of a convergence ladder (0: the
-/// config's grid; level k has about 2^(k/2) times its points per side on the
-/// same domain).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// the config uses, the ball of a sweep over balls (`sweep.indenters`), and
+/// the grid level of a convergence ladder (0: the config's grid; level k has
+/// about 2^(k/2) times its points per side on the same domain).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 pub struct CaseKey {
     /// Material name (a preset or a `[materials.*]` key).
     pub material: String,
@@ -26,6 +28,36 @@ pub struct CaseKey {
     /// out cannot be read back; journals written before ladders read as 0.
     #[serde(default)]
     pub level: usize,
+    /// The ball of a sweep over balls: an entry of `sweep.indenters`
+    /// (`rigid` included). `None` in a sweep without that axis, whose one
+    /// ball (`indenter.material`, or rigid) is not part of any identity, so
+    /// that its ids, paths, journal lines and CSVs are those of before.
+    /// Serialised always in binary formats (the IPC header's bincode), left
+    /// out of JSON when `None` (journal lines as before); journals written
+    /// before balls read as `None`.
+    #[serde(default)]
+    pub indenter: Option<String>,
+}
+
+impl Serialize for CaseKey {
+    /// Every field, in order, for bincode (not self-describing: a field
+    /// left out could not be read back); in a human-readable format (the
+    /// journal's JSON) `indenter` only when there is one, so a key without
+    /// a ball writes the line it wrote before balls existed.
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let omit = s.is_human_readable() && self.indenter.is_none();
+        let mut st = s.serialize_struct("CaseKey", if omit { 4 } else { 5 })?;
+        st.serialize_field("material", &self.material)?;
+        st.serialize_field("surface", &self.surface)?;
+        st.serialize_field("angle_deg", &self.angle_deg)?;
+        st.serialize_field("level", &self.level)?;
+        if omit {
+            st.skip_field("indenter")?;
+        } else {
+            st.serialize_field("indenter", &self.indenter)?;
+        }
+        st.end()
+    }
 }
 
 impl CaseKey {
@@ -36,7 +68,15 @@ impl CaseKey {
             surface: surface.to_string(),
             angle_deg,
             level: 0,
+            indenter: None,
         }
+    }
+
+    /// The same case pressed by the ball `name` of a sweep over balls
+    /// (`rigid` for none).
+    pub fn with_indenter(mut self, name: &str) -> Self {
+        self.indenter = Some(name.to_string());
+        self
     }
 
     /// The same case on ladder level `level`.
@@ -58,7 +98,8 @@ impl CaseKey {
 
 impl fmt::Display for CaseKey {
     /// `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`, with
-    /// `/L2` appended on ladder level 2.
+    /// `@ball` appended in a sweep over balls (`Cu/flat/000.0@steel`) and
+    /// `/L2` on ladder level 2 (`Cu/flat/000.0@steel/L2`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
@@ -67,6 +108,9 @@ impl fmt::Display for CaseKey {
             self.surface,
             self.angle_text()
         )?;
+        if let Some(ball) = &self.indenter {
+            write!(f, "@{ball}")?;
+        }
         if self.level > 0 {
             write!(f, "/L{}", self.level)?;
         }
@@ -145,6 +189,39 @@ mod tests {
         let back: CaseKey = serde_json::from_str(&serde_json::to_string(&k2).unwrap()).unwrap();
         assert_eq!(back, k2);
         assert_eq!(k2.point(), k);
+    }
+
+    #[test]
+    fn a_ball_shows_in_the_id_and_keys_without_one_write_the_old_json() {
+        let k = CaseKey::new("Cu", "flat", 0.0).with_indenter("steel");
+        assert_eq!(k.to_string(), "Cu/flat/000.0@steel");
+        assert_eq!(k.clone().at_level(1).to_string(), "Cu/flat/000.0@steel/L1");
+        assert_eq!(k.clone().at_level(1).point(), k);
+        let plain = CaseKey::new("Cu", "flat", 15.0);
+        assert_eq!(
+            serde_json::to_string(&plain).unwrap(),
+            r#"{"material":"Cu","surface":"flat","angle_deg":15.0,"level":0}"#
+        );
+        let text = serde_json::to_string(&k).unwrap();
+        assert!(text.ends_with(r#""level":0,"indenter":"steel"}"#), "{text}");
+        assert_eq!(serde_json::from_str::<CaseKey>(&text).unwrap(), k);
+        assert_ne!(k, CaseKey::new("Cu", "flat", 0.0).with_indenter("rigid"));
+        assert_ne!(k, CaseKey::new("Cu", "flat", 0.0));
+    }
+
+    #[test]
+    fn keys_cross_the_wire_with_every_field() {
+        // bincode is not self-describing: the key must write `indenter`
+        // whether or not it has one, and read back what it wrote.
+        for k in [
+            CaseKey::new("Cu", "flat", 15.0).at_level(2),
+            CaseKey::new("Cu", "flat", 15.0).with_indenter("WC"),
+        ] {
+            let env = protocol::Envelope::new("run", (k.clone(), 7u32));
+            let bytes = protocol::encode_to_vec(&env, &[]).unwrap();
+            let back = protocol::decode::<(CaseKey, u32)>(&bytes, "run").unwrap();
+            assert_eq!(back.header.body, (k, 7));
+        }
     }
 
     #[test]

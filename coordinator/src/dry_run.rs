@@ -73,8 +73,20 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         let _ = writeln!(s, "ladder:    {levels} levels: {}", sizes.join(", "));
     }
     let list = |v: &[String]| v.join(", ");
-    let ball = config.indenter.material.as_deref().unwrap_or("rigid");
-    let _ = writeln!(s, "indenter:  R = {} mm, {ball}", config.indenter.radius_mm);
+    let balls = match &config.sweep.indenters {
+        Some(names) => format!("{} balls ({})", names.len(), list(names)),
+        None => config
+            .indenter
+            .material
+            .as_deref()
+            .unwrap_or(crate::config::RIGID)
+            .to_string(),
+    };
+    let _ = writeln!(
+        s,
+        "indenter:  R = {} mm, {balls}",
+        config.indenter.radius_mm
+    );
     let _ = writeln!(
         s,
         "materials: {} ({})",
@@ -89,9 +101,13 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     );
     let shown: Vec<String> = angles.iter().map(|a| format!("{a}")).collect();
     let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
+    let ball_axis = match &config.sweep.indenters {
+        Some(names) => format!(" x {} balls", names.len()),
+        None => String::new(),
+    };
     let _ = writeln!(
         s,
-        "cases:     {} = {} materials x {} surfaces x {} angles x {levels} level(s)",
+        "cases:     {} = {} materials x {} surfaces x {} angles{ball_axis} x {levels} level(s)",
         cases.len(),
         config.sweep.materials.len(),
         config.sweep.surfaces.len(),

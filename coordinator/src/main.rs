@@ -91,6 +91,10 @@ enum Cmd {
         /// Force direction in degrees (default: the sweep's first).
         #[arg(long = "angle-deg", allow_hyphen_values = true)]
         angle_deg: Option<f64>,
+        /// The ball: `rigid`, a preset or a [materials.NAME] table (default:
+        /// the first of sweep.indenters, else indenter.material, else rigid).
+        #[arg(long)]
+        indenter: Option<String>,
         /// Output directory.
         #[arg(long, default_value = "out-solve")]
         out: PathBuf,
@@ -272,6 +276,7 @@ fn real_main() -> Result<ExitCode> {
             material,
             surface,
             angle_deg,
+            indenter,
             out,
             sets,
             threads,
@@ -285,6 +290,7 @@ fn real_main() -> Result<ExitCode> {
                     material: material.as_deref(),
                     surface: surface.as_deref(),
                     angle_deg,
+                    indenter: indenter.as_deref(),
                     out: &out,
                     threads,
                     quiet,

@@ -56,6 +56,9 @@ pub struct SolveArgs<'a> {
     pub surface: Option<&'a str>,
     /// Force angle (default: the sweep's first).
     pub angle_deg: Option<f64>,
+    /// The ball: `rigid`, a preset or a `[materials.NAME]` table (default:
+    /// the first of `sweep.indenters`, else `indenter.material`, else rigid).
+    pub indenter: Option<&'a str>,
     /// Output directory.
     pub out: &'a Path,
     /// Threads for the case (results do not depend on it).
@@ -108,6 +111,17 @@ impl CaseChoice {
         Self::checked(config, material, label, angle, spec)
     }
 
+    /// The same case pressed by the ball `name` (`rigid`, a preset or a
+    /// `[materials.NAME]` table) instead of the config's first; `key` is
+    /// the option that gave it, named in errors (`--indenter`).
+    pub fn with_indenter(mut self, config: &Config, key: &str, name: &str) -> Result<Self> {
+        self.spec.indenter = config.ball(key, name)?;
+        self.spec
+            .validate()
+            .map_err(|e| config.explain_pressed(e, &self.material, &self.surface, Some(name)))?;
+        Ok(self)
+    }
+
     fn angle(config: &Config, angle_deg: Option<f64>) -> Result<f64> {
         match angle_deg {
             Some(a) => Ok(a),
@@ -122,8 +136,12 @@ impl CaseChoice {
         angle_deg: f64,
         spec: CaseSpec,
     ) -> Result<Self> {
+        let ball = match &config.sweep.indenters {
+            Some(names) => Some(names[0].as_str()),
+            None => config.indenter.material.as_deref(),
+        };
         spec.validate()
-            .map_err(|e| config.explain(e, material, surface))?;
+            .map_err(|e| config.explain_pressed(e, material, surface, ball))?;
         Ok(CaseChoice {
             material: material.to_string(),
             surface: surface.to_string(),
@@ -236,7 +254,10 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
 
 /// Solves one case of `config` and writes its outputs; returns its scalars.
 pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
-    let case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
+    let mut case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
+    if let Some(name) = args.indenter {
+        case = case.with_indenter(config, "--indenter", name)?;
+    }
     let label = format!("{}/{}/{}°", case.material, case.surface, case.angle_deg);
     let progress = SolveProgress::start(args.quiet, &label);
     let solved = solve_in_memory(case, args.threads);
@@ -245,4 +266,47 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let solved = solved?;
     write_solved(&solved, args.out)?;
     Ok(solved.scalars)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BALLS: &str = r#"
+[grid]
+points = 64
+spacing_um = 2.0
+
+[indenter]
+radius_mm = 18.0
+
+[load]
+normal_n = 20.0
+friction = 0.3
+
+[sweep]
+materials = ["Fe"]
+indenters = ["steel", "rigid"]
+"#;
+
+    #[test]
+    fn issue35_solve_takes_the_axis_first_ball_or_the_one_named() {
+        let c = Config::parse(BALLS, &[]).unwrap();
+        let first = CaseChoice::new(&c, None, None, None).unwrap();
+        assert_eq!(first.spec.indenter.as_ref().unwrap().name, "steel");
+        let rigid = first
+            .clone()
+            .with_indenter(&c, "--indenter", "rigid")
+            .unwrap();
+        assert!(rigid.spec.indenter.is_none());
+        let wc = first.clone().with_indenter(&c, "--indenter", "WC").unwrap();
+        assert_eq!(wc.spec.indenter.as_ref().unwrap().name, "WC");
+        let e = format!(
+            "{:#}",
+            first
+                .with_indenter(&c, "--indenter", "Mithril")
+                .unwrap_err()
+        );
+        assert!(e.contains("--indenter: unknown material `Mithril`"), "{e}");
+    }
 }

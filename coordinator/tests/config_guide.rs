@@ -68,6 +68,7 @@ fn accepted_keys() -> BTreeSet<String> {
     .unwrap();
     c.surfaces.insert("NAME".into(), surface);
     c.indenter.material = Some("steel".into());
+    c.sweep.indenters = Some(vec!["rigid".into(), "steel".into()]);
     c.run = RunCfg {
         case_timeout_s: 5.0,
     };

@@ -1314,3 +1314,139 @@ fn issue33_item4_a_paused_coordinator_carries_on_and_sigterm_still_stops_it() {
     );
     assert!(journalled(&stopped_out) < 14, "the sweep was not cut short");
 }
+
+/// Issue #35: a quick.toml-sized sweep over balls (64², Cu × flat × 0°, 90°
+/// × rigid, steel), with its one-ball twins.
+const BALLS_CONFIG: &str = r#"
+[grid]
+points = 64
+spacing_um = 120.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["flat"]
+angles_deg = [0, 90]
+"#;
+
+/// The rows of a CSV as text, without `seconds`, `worker` and the columns
+/// in `drop`, keyed by the rows' `indenter` cell (`""` without that column).
+fn rows_by_ball(path: &Path, drop: &[&str]) -> BTreeMap<String, Vec<String>> {
+    let rows = read_csv(path);
+    let header = &rows[0];
+    let ball = header.iter().position(|h| h == "indenter");
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&i| !["seconds", "worker", "indenter"].contains(&header[i].as_str()))
+        .filter(|&i| !drop.contains(&header[i].as_str()))
+        .collect();
+    let mut out: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for r in &rows[1..] {
+        let name = ball.map(|b| r[b].clone()).unwrap_or_default();
+        let cells: Vec<&str> = keep.iter().map(|&i| r[i].as_str()).collect();
+        out.entry(name).or_default().push(cells.join(","));
+    }
+    out
+}
+
+#[test]
+fn issue35_a_ball_axis_runs_every_ball_and_matches_the_one_ball_sweeps() {
+    let dir = scratch("balls");
+    let axis = BALLS_CONFIG.replace(
+        "surfaces = [\"flat\"]",
+        "surfaces = [\"flat\"]\nindenters = [\"rigid\", \"steel\"]",
+    );
+    let steel = BALLS_CONFIG.replace(
+        "radius_mm = 200.0",
+        "radius_mm = 200.0\nmaterial = \"steel\"",
+    );
+    for (name, text) in [
+        ("axis", &axis),
+        ("rigid", &BALLS_CONFIG.to_string()),
+        ("steel", &steel),
+    ] {
+        std::fs::write(dir.join("sweep.toml"), text).unwrap();
+        check_ok(
+            &sweep_cmd(&dir, name, 2, "b").output().unwrap(),
+            &format!("{name} sweep"),
+        );
+    }
+    let o = dir.join("axis");
+    // Four cases, each its own identity, recorded once.
+    let ids: BTreeSet<String> = journal_cases(&o)
+        .iter()
+        .map(|v| v["case_id"].as_str().unwrap().to_string())
+        .collect();
+    let want: BTreeSet<String> = [
+        "Cu/flat/000.0@rigid",
+        "Cu/flat/000.0@steel",
+        "Cu/flat/090.0@rigid",
+        "Cu/flat/090.0@steel",
+    ]
+    .map(String::from)
+    .into();
+    assert_eq!(ids, want);
+    assert_eq!(journal_cases(&o).len(), 4);
+    let key: CaseKey = serde_json::from_value(journal_cases(&o)[0]["key"].clone()).unwrap();
+    assert!(key.indenter.is_some(), "{key:?}");
+    // The headers: the indenter column after surface, only with the axis.
+    let header = |out: &str, f: &str| read_csv(&dir.join(out).join(f))[0].join(",");
+    assert_eq!(
+        header("axis", "results.csv"),
+        coordinator::run::RESULTS_HEADER.replacen("surface,", "surface,indenter,", 1)
+    );
+    assert_eq!(
+        header("axis", "curves.csv"),
+        coordinator::run::CURVES_HEADER.replacen("surface,", "surface,indenter,", 1)
+    );
+    for one in ["rigid", "steel"] {
+        assert_eq!(header(one, "results.csv"), coordinator::run::RESULTS_HEADER);
+        assert_eq!(header(one, "curves.csv"), coordinator::run::CURVES_HEADER);
+    }
+    // Each ball's rows are its one-ball sweep's, to the bit.
+    for f in ["results.csv", "curves.csv"] {
+        let by_ball = rows_by_ball(&o.join(f), &[]);
+        assert_eq!(by_ball.len(), 2, "{f}: {by_ball:?}");
+        for one in ["rigid", "steel"] {
+            let alone = rows_by_ball(&dir.join(one).join(f), &[]);
+            assert_eq!(by_ball[one], alone[""], "{f}: {one}");
+        }
+        // ... and the balls differ (a steel ball is not a rigid one).
+        assert_ne!(by_ball["rigid"], by_ball["steel"], "{f}");
+    }
+    let summary = summary(&o);
+    let curves = summary["curves"].as_object().unwrap();
+    let names: Vec<&str> = curves.keys().map(String::as_str).collect();
+    assert_eq!(names, ["Cu / flat @ rigid", "Cu / flat @ steel"]);
+    assert_eq!(summary["total"], 4);
+    // A resume of the finished sweep finds every typed key with its ball.
+    std::fs::write(dir.join("sweep.toml"), &axis).unwrap();
+    let mut c = sweep_cmd(&dir, "axis", 2, "b");
+    c.arg("--resume");
+    check_ok(&c.output().unwrap(), "resume");
+    assert_eq!(journal_cases(&o).len(), 4);
+    assert_eq!(self::summary(&o)["resumed"], 4);
+    // `check` counts the balls and names each pair's kernel.
+    let check = Command::new(EXE)
+        .arg("check")
+        .arg(dir.join("sweep.toml"))
+        .output()
+        .unwrap();
+    check_ok(&check, "check");
+    let text = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        text.contains("cases:     4 = 1 materials x 1 surfaces x 2 angles x 2 balls"),
+        "{text}"
+    );
+    assert!(
+        text.contains("Cu + ball steel") && text.contains("2 balls (rigid, steel)"),
+        "{text}"
+    );
+    assert!(shm_leftovers("b").is_empty());
+}

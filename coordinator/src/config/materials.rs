@@ -2,7 +2,7 @@
 //! cubic constants with an orientation), how a name resolves (tables first,
 //! then presets) and the config keys of a material's solver parameters.
 
-use super::{within, Config};
+use super::{within, Config, RIGID};
 use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
 use solver::{Isotropic, Material, SolverError};
@@ -73,6 +73,41 @@ impl Config {
             .as_deref()
             .map(|name| self.material_for("indenter.material", name))
             .transpose()
+    }
+
+    /// The balls of the sweep, in order: each with its name in case keys
+    /// (`None` without `sweep.indenters`: the one ball of
+    /// `indenter.material`, or rigid, is no part of any identity) and its
+    /// material (`None`: rigid). Errors name the key.
+    pub fn balls(&self) -> Result<Vec<(Option<String>, Option<Material>)>> {
+        let Some(names) = &self.sweep.indenters else {
+            return Ok(vec![(None, self.indenter_material()?)]);
+        };
+        if self.indenter.material.is_some() {
+            bail!("indenter.material and sweep.indenters both choose the ball: give one ball as indenter.material, or the balls to compare as sweep.indenters (`{RIGID}` for a rigid one), not both");
+        }
+        if names.iter().any(|n| n == RIGID) && self.materials.contains_key(RIGID) {
+            bail!("sweep.indenters: `{RIGID}` means a rigid ball, so the table [materials.{RIGID}] cannot be a ball; rename the table");
+        }
+        names
+            .iter()
+            .map(|name| Ok((Some(name.clone()), self.ball("sweep.indenters", name)?)))
+            .collect()
+    }
+
+    /// The ball `name` given under `key`: `rigid` (`None`), a preset or a
+    /// `[materials.NAME]` table.
+    pub fn ball(&self, key: &str, name: &str) -> Result<Option<Material>> {
+        if name == RIGID {
+            return Ok(None);
+        }
+        self.material_for(key, name).map(Some)
+    }
+
+    /// The ball a single case is pressed by when none is chosen: the first
+    /// of `sweep.indenters`, else `indenter.material`, else rigid.
+    pub fn default_ball(&self) -> Result<Option<Material>> {
+        Ok(self.balls()?.swap_remove(0).1)
     }
 
     /// Resolves a material name given under the config key `key`.

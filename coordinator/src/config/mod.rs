@@ -25,7 +25,7 @@ pub use history::{FrettingCfg, HistoryCfg, MAX_CYCLES};
 pub use materials::{CubicCfg, IsoCfg, MaterialCfg};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};
 pub use surfaces::{heightmap_surface, SurfaceCfg};
-pub use sweep::{AnglesCfg, SweepCfg, MAX_ANGLES};
+pub use sweep::{AnglesCfg, SweepCfg, MAX_ANGLES, RIGID};
 
 use crate::case::CaseKey;
 use anyhow::{anyhow, bail, Context, Result};
@@ -155,8 +155,20 @@ impl Config {
     }
 
     /// A solver error with its parameter named by its config key, for a
-    /// case of `material` on `surface`.
+    /// case of `material` on `surface` pressed by the config's one ball.
     pub fn explain(&self, e: SolverError, material: &str, surface: &str) -> anyhow::Error {
+        self.explain_pressed(e, material, surface, self.indenter.material.as_deref())
+    }
+
+    /// The same for a case pressed by the ball `ball` (a material name;
+    /// `None` or `rigid`: no ball).
+    pub fn explain_pressed(
+        &self,
+        e: SolverError,
+        material: &str,
+        surface: &str,
+        ball: Option<&str>,
+    ) -> anyhow::Error {
         let SolverError::Invalid { field, reason } = e else {
             return anyhow!("{e}");
         };
@@ -166,7 +178,7 @@ impl Config {
                 materials::material_key(p, self.materials.get(material))
             )
         } else if let Some(p) = field.strip_prefix("indenter.") {
-            let ball = self.indenter.material.as_deref().unwrap_or_default();
+            let ball = ball.unwrap_or_default();
             format!(
                 "materials.{ball}.{}",
                 materials::material_key(p, self.materials.get(ball))
@@ -193,19 +205,24 @@ impl Config {
         // Whether the workers fit in this machine's memory is checked where
         // they start (`memory::check_fits`), not here.
         for (key, spec) in self.cases()? {
+            let ball = key
+                .indenter
+                .as_deref()
+                .or(self.indenter.material.as_deref());
             spec.validate()
-                .map_err(|e| self.explain(e, &key.material, &key.surface))?;
+                .map_err(|e| self.explain_pressed(e, &key.material, &key.surface, ball))?;
         }
         Ok(())
     }
 
-    /// One case spec.
+    /// One case spec, pressed by the sweep's first ball
+    /// ([`Config::default_ball`]).
     pub fn spec(&self, material: &str, surface: &str, angle_deg: f64) -> Result<CaseSpec> {
         Ok(self.spec_of(
             self.material(material)?,
             self.surface(surface)?,
             angle_deg,
-            self.indenter_material()?,
+            self.default_ball()?,
         ))
     }
 
@@ -216,7 +233,7 @@ impl Config {
             self.material(material)?,
             surface,
             angle_deg,
-            self.indenter_material()?,
+            self.default_ball()?,
         ))
     }
 
@@ -248,7 +265,9 @@ impl Config {
     }
 
     /// All cases of the sweep in a fixed order: materials × surfaces × angles
-    /// (× ladder levels, finest last). Each material and surface is resolved once.
+    /// × balls (× ladder levels, finest last). Each material, surface and
+    /// ball is resolved once. Without `sweep.indenters` there is one ball
+    /// and the keys carry none (the cases of before).
     pub fn cases(&self) -> Result<Vec<(CaseKey, CaseSpec)>> {
         let angles = self.sweep.angles_deg.values()?;
         let surfaces = self
@@ -265,28 +284,33 @@ impl Config {
                 Ok((s, surface))
             })
             .collect::<Result<Vec<_>>>()?;
-        let indenter = self.indenter_material()?;
+        let balls = self.balls()?;
         let mut out = Vec::new();
         for m in &self.sweep.materials {
             let material = self.material(m)?;
             for (s, surface) in &surfaces {
                 for &a in &angles {
-                    let spec = self.spec_of(material.clone(), surface.clone(), a, indenter.clone());
-                    let finer: Vec<_> = (1..self.convergence.levels)
-                        .map(|level| {
-                            let grid = self.level_grid(level);
-                            let key = CaseKey::new(m, s, a).at_level(level);
-                            (
-                                key,
-                                CaseSpec {
-                                    grid,
-                                    ..spec.clone()
-                                },
-                            )
-                        })
-                        .collect();
-                    out.push((CaseKey::new(m, s, a), spec));
-                    out.extend(finer);
+                    for (name, ball) in &balls {
+                        let key = match name {
+                            Some(name) => CaseKey::new(m, s, a).with_indenter(name),
+                            None => CaseKey::new(m, s, a),
+                        };
+                        let spec = self.spec_of(material.clone(), surface.clone(), a, ball.clone());
+                        let finer: Vec<_> = (1..self.convergence.levels)
+                            .map(|level| {
+                                let grid = self.level_grid(level);
+                                (
+                                    key.clone().at_level(level),
+                                    CaseSpec {
+                                        grid,
+                                        ..spec.clone()
+                                    },
+                                )
+                            })
+                            .collect();
+                        out.push((key, spec));
+                        out.extend(finer);
+                    }
                 }
             }
         }

@@ -1,5 +1,5 @@
-//! `[sweep]`: which materials, surfaces and force angles make the cases,
-//! and that every case has its own identity. The names are resolved by
+//! `[sweep]`: which materials, surfaces, force angles and balls make the
+//! cases, and that every case has its own identity. The names are resolved by
 //! `materials` and `surfaces`; the cases are made in `Config::cases`.
 
 use anyhow::{bail, Result};
@@ -137,7 +137,17 @@ pub struct SweepCfg {
     /// Force directions.
     #[serde(default = "default_angles")]
     pub angles_deg: AnglesCfg,
+    /// Balls to compare (`sweep.indenters`): presets or keys of
+    /// `[materials.*]`, [`RIGID`] for a rigid ball. Absent: no ball axis,
+    /// the one ball of `indenter.material` (or rigid) presses every case.
+    /// Not written back when absent, so that configs without it echo (and
+    /// resume) as before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indenters: Option<Vec<String>>,
 }
+
+/// The name that means "no ball" in `sweep.indenters`.
+pub const RIGID: &str = "rigid";
 
 fn default_surfaces() -> Vec<String> {
     vec!["flat".into()]
@@ -156,16 +166,25 @@ impl SweepCfg {
         if self.surfaces.is_empty() {
             bail!("sweep.surfaces: list at least one surface");
         }
+        if self.indenters.as_ref().is_some_and(Vec::is_empty) {
+            bail!("sweep.indenters: list at least one ball (`{RIGID}` for a rigid one), or leave the key out");
+        }
         Ok(())
     }
 
-    /// Every case must have its own identity: no material or surface listed
-    /// twice, and no two angles that case ids and outputs (0.1°) cannot tell
-    /// apart. (Repeated keys made `run` re-send a case forever, #20 item 1.)
+    /// Every case must have its own identity: no material, surface or ball
+    /// listed twice, and no two angles that case ids and outputs (0.1°)
+    /// cannot tell apart. (Repeated keys made `run` re-send a case forever,
+    /// #20 item 1.)
     pub(super) fn check_unique(&self, angles: &[f64]) -> Result<()> {
+        let no_balls = Vec::new();
         for (key, names) in [
             ("sweep.materials", &self.materials),
             ("sweep.surfaces", &self.surfaces),
+            (
+                "sweep.indenters",
+                self.indenters.as_ref().unwrap_or(&no_balls),
+            ),
         ] {
             let mut seen = std::collections::HashSet::new();
             if let Some(name) = names.iter().find(|n| !seen.insert(n.as_str())) {
@@ -243,6 +262,72 @@ mod tests {
             "angles_deg = [0.0, 0.1, 0.2]",
         );
         assert_eq!(Config::parse(&ok, &[]).unwrap().cases().unwrap().len(), 3);
+    }
+
+    #[test]
+    fn issue35_ball_axis_errors_name_the_key() {
+        let axis = |list: &str| {
+            BASE.replace(
+                "surfaces = [\"flat\"]",
+                &format!("surfaces = [\"flat\"]\nindenters = {list}"),
+            )
+        };
+        let cases: [(String, &str); 5] = [
+            (axis("[]"), "sweep.indenters: list at least one ball"),
+            (
+                axis("[\"rigid\", \"steel\", \"steel\"]"),
+                "sweep.indenters: `steel` is listed twice",
+            ),
+            (
+                axis("[\"rigid\", \"Vibranium\"]"),
+                "sweep.indenters: unknown material `Vibranium`",
+            ),
+            (
+                axis("[\"steel\"]")
+                    .replace("radius_mm = 18.0", "radius_mm = 18.0\nmaterial = \"WC\""),
+                "indenter.material and sweep.indenters",
+            ),
+            (
+                format!(
+                    "{}\n[materials.rigid]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\n",
+                    axis("[\"rigid\"]")
+                ),
+                "sweep.indenters: `rigid` means a rigid ball",
+            ),
+        ];
+        for (text, expect) in cases {
+            assert_ne!(text, BASE);
+            let e = err(&text, &[]);
+            assert!(e.contains(expect), "{expect}: {e}");
+        }
+        // Via --set too, and a good axis expands to every ball in turn.
+        let e = err(BASE, &["sweep.indenters=[\"rigid\", \"glas\"]"]);
+        assert!(
+            e.contains("sweep.indenters: unknown material `glas`"),
+            "{e}"
+        );
+        let c = Config::parse(&axis("[\"rigid\", \"steel\"]"), &[]).unwrap();
+        let cases = c.cases().unwrap();
+        let ids: Vec<String> = cases.iter().map(|(k, _)| k.to_string()).collect();
+        assert_eq!(
+            ids,
+            [
+                "Fe/flat/000.0@rigid",
+                "Fe/flat/000.0@steel",
+                "Fe/flat/045.0@rigid",
+                "Fe/flat/045.0@steel",
+                "Fe/flat/090.0@rigid",
+                "Fe/flat/090.0@steel",
+            ]
+        );
+        assert!(cases[0].1.indenter.is_none());
+        assert_eq!(cases[1].1.indenter.as_ref().unwrap().name, "steel");
+        // The config echo keeps the axis (a resume compares it) and only then.
+        assert!(c.to_toml().contains("indenters"));
+        assert!(!Config::parse(BASE, &[])
+            .unwrap()
+            .to_toml()
+            .contains("indenters"));
     }
 
     #[test]

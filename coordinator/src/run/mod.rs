@@ -244,7 +244,10 @@ fn write_outputs(
             continue;
         };
         let key = &r.case.key;
-        let title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
+        let mut title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
+        if let Some(ball) = &key.indenter {
+            title.push_str(&format!(", {ball} ball"));
+        }
         match crate::history_out::write_history(&output::fields_dir(dir, key), h, &title) {
             Ok(warnings) => summary.output_warnings.extend(warnings),
             Err(e) => summary

@@ -24,6 +24,34 @@ pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,con
 /// Header of `curves.csv`.
 pub const CURVES_HEADER: &str =
     "material,surface,angle_deg,mu_a,mu_a_err,k_e,k_e_err,method,order,mu_a_by_level,mu_a_cells";
+/// The column both CSVs gain, after `surface`, in a sweep over balls
+/// (`sweep.indenters`): the ball's name, `rigid` for none. A sweep without
+/// that axis has the headers above, to the byte.
+pub const INDENTER_COLUMN: &str = "indenter";
+
+/// `header` with [`INDENTER_COLUMN`] after `surface` when `balls`.
+fn header_with_balls(header: &str, balls: bool) -> String {
+    if balls {
+        header.replacen(
+            "material,surface,",
+            &format!("material,surface,{INDENTER_COLUMN},"),
+            1,
+        )
+    } else {
+        header.to_string()
+    }
+}
+
+/// The cells that name a case's curve: `material,surface,` and, in a sweep
+/// over balls, the ball.
+fn identity_cells(key: &CaseKey, balls: bool) -> String {
+    let mut cells = format!("{},{},", csv_field(&key.material), csv_field(&key.surface));
+    if balls {
+        cells.push_str(&csv_field(key.indenter.as_deref().unwrap_or_default()));
+        cells.push(',');
+    }
+    cells
+}
 
 /// A finished case ready for output: its plan entry, its record and the
 /// scalars after K_E calibration.
@@ -77,9 +105,10 @@ fn opt(v: Option<f64>) -> String {
     v.map(fmt_f64).unwrap_or_default()
 }
 
-/// Text of `results.csv`.
+/// Text of `results.csv` (with [`INDENTER_COLUMN`] in a sweep over balls).
 pub fn results_csv(rows: &[Row]) -> String {
-    let mut out = String::from(RESULTS_HEADER);
+    let balls = rows.iter().any(|r| r.case.key.indenter.is_some());
+    let mut out = header_with_balls(RESULTS_HEADER, balls);
     out.push('\n');
     for r in rows {
         let c = r.case;
@@ -88,9 +117,8 @@ pub fn results_csv(rows: &[Row]) -> String {
         let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
-            csv_field(&c.key.material),
-            csv_field(&c.key.surface),
+            "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
+            identity_cells(&c.key, balls),
             fmt_f64(c.spec.load.angle_deg),
             r.record.status,
             opt(s.and_then(|s| s.mu_a)),
@@ -127,8 +155,8 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// One point of a μa-versus-angle curve: a material × surface × angle,
-/// from every level of its ladder (one level without a ladder).
+/// One point of a μa-versus-angle curve: a material × surface × angle
+/// (× ball in a sweep over balls), from every level of its ladder (one level without a ladder).
 #[derive(Clone, Debug)]
 pub struct CurvePoint {
     /// The point's key (level 0).
@@ -212,11 +240,13 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
 /// Columns `curves.csv` gains when the sweep has a load history.
 pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
 
-/// Text of `curves.csv` (with [`CURVES_HISTORY_COLUMNS`] when any point
-/// has a dissipated energy per cycle).
+/// Text of `curves.csv` (with [`INDENTER_COLUMN`] in a sweep over balls,
+/// and [`CURVES_HISTORY_COLUMNS`] when any point has a dissipated energy
+/// per cycle).
 pub fn curves_csv(points: &[CurvePoint]) -> String {
     let history = points.iter().any(|p| p.dissipated.is_some());
-    let mut out = String::from(CURVES_HEADER);
+    let balls = points.iter().any(|p| p.key.indenter.is_some());
+    let mut out = header_with_balls(CURVES_HEADER, balls);
     if history {
         out.push(',');
         out.push_str(CURVES_HISTORY_COLUMNS);
@@ -226,9 +256,8 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
         let by_level: Vec<String> = p.mu_a_by_level.iter().map(|&v| fmt_f64(v)).collect();
         let _ = write!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{}",
-            csv_field(&p.key.material),
-            csv_field(&p.key.surface),
+            "{}{},{},{},{},{},{},{},{},{}",
+            identity_cells(&p.key, balls),
             fmt_f64(p.key.angle_deg),
             fmt_f64(p.mu_a.value),
             opt(p.mu_a.err),
@@ -252,7 +281,7 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
     out
 }
 
-/// What `summary.json` says of one material × surface curve.
+/// What `summary.json` says of one material × surface (× ball) curve.
 #[derive(Clone, Debug, Serialize)]
 pub struct CurveSummary {
     /// Points on the curve.
@@ -269,13 +298,21 @@ pub struct CurveSummary {
     pub resolved: Option<bool>,
 }
 
-/// The curve points of each material × surface, keyed by (material,
-/// surface), sorted by angle: the one grouping behind `summary.json`'s
-/// curves and the figure.
-fn by_curve(points: &[CurvePoint]) -> BTreeMap<(&str, &str), Vec<&CurvePoint>> {
-    let mut m: BTreeMap<(&str, &str), Vec<&CurvePoint>> = BTreeMap::new();
+/// A curve: material, and the surface's name in the figure's legend and
+/// summary.json (`flat`, or `flat @ steel` in a sweep over balls).
+type CurveId<'a> = (&'a str, String);
+
+/// The curve points of each material × surface (× ball), keyed by
+/// (material, surface label), sorted by angle: the one grouping behind
+/// `summary.json`'s curves and the figure.
+fn by_curve(points: &[CurvePoint]) -> BTreeMap<CurveId<'_>, Vec<&CurvePoint>> {
+    let mut m: BTreeMap<CurveId<'_>, Vec<&CurvePoint>> = BTreeMap::new();
     for p in points {
-        m.entry((p.key.material.as_str(), p.key.surface.as_str()))
+        let surface = match &p.key.indenter {
+            Some(ball) => format!("{} @ {ball}", p.key.surface),
+            None => p.key.surface.clone(),
+        };
+        m.entry((p.key.material.as_str(), surface))
             .or_default()
             .push(p);
     }
@@ -285,8 +322,9 @@ fn by_curve(points: &[CurvePoint]) -> BTreeMap<(&str, &str), Vec<&CurvePoint>> {
     m
 }
 
-/// Per material × surface ("material / surface"): range of μa over angle,
-/// its error and whether the variation is resolved.
+/// Per material × surface ("material / surface", "material / surface @
+/// ball" in a sweep over balls): range of μa over angle, its error and
+/// whether the variation is resolved.
 pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> {
     let mut out = BTreeMap::new();
     for ((material, surface), pts) in by_curve(points) {
@@ -343,13 +381,17 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
         let mu = pts
             .iter()
             .map(|p| (p.key.angle_deg, p.mu_a.value, p.mu_a.err));
-        panel.series.insert(surface.to_string(), mu.collect());
+        panel.series.insert(surface, mu.collect());
         if pts.iter().all(|p| p.flat_calibration) {
             let gpa = |v: f64| v / 1e9;
             let ke = pts
                 .iter()
                 .map(|p| (p.key.angle_deg, gpa(p.k_e.value), p.k_e.err.map(gpa)));
-            k_e.series.insert(material.to_string(), ke.collect());
+            let name = match &pts[0].key.indenter {
+                Some(ball) => format!("{material} @ {ball}"),
+                None => material.to_string(),
+            };
+            k_e.series.insert(name, ke.collect());
         }
     }
     // Energy per cycle (load histories): one panel per material, in μJ.
@@ -372,7 +414,7 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
                     series: BTreeMap::new(),
                 })
                 .series
-                .insert(surface.to_string(), e);
+                .insert(surface, e);
         }
     }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
@@ -549,23 +591,12 @@ where
 }
 
 /// Directory of a case's fields: `fields/<material>/<surface>/<angle>`
-/// (`fields/Cu/flat/015.0`), each component made file-name safe.
+/// (`fields/Cu/flat/015.0`), `<angle>@<ball>` in a sweep over balls
+/// (`fields/Cu/flat/015.0@steel`, the display text's last part), each
+/// component made file-name safe; ladder level k > 0 under `L<k>`.
 pub fn fields_dir(out_dir: &Path, key: &CaseKey) -> PathBuf {
     let mut p = out_dir.join("fields");
-    let level = format!("L{}", key.level);
-    let parts = [
-        key.material.as_str(),
-        key.surface.as_str(),
-        &key.angle_text(),
-        &level,
-    ];
-    // Level 0 keeps the directory it had before ladders existed.
-    let parts = if key.level == 0 {
-        &parts[..3]
-    } else {
-        &parts[..]
-    };
-    for part in parts {
+    let safe = |part: &str| -> String {
         let safe: String = part
             .chars()
             .map(|c| {
@@ -576,11 +607,21 @@ pub fn fields_dir(out_dir: &Path, key: &CaseKey) -> PathBuf {
                 }
             })
             .collect();
-        p.push(if safe.is_empty() || safe == "." || safe == ".." {
+        if safe.is_empty() || safe == "." || safe == ".." {
             "_".to_string()
         } else {
             safe
-        });
+        }
+    };
+    p.push(safe(&key.material));
+    p.push(safe(&key.surface));
+    match &key.indenter {
+        Some(ball) => p.push(format!("{}@{}", key.angle_text(), safe(ball))),
+        None => p.push(safe(&key.angle_text())),
+    }
+    // Level 0 keeps the directory it had before ladders existed.
+    if key.level > 0 {
+        p.push(format!("L{}", key.level));
     }
     p
 }
@@ -692,8 +733,75 @@ mod tests {
     }
 
     #[test]
+    fn issue35_each_ball_calibrates_on_its_own_flat_twin() {
+        let lattice = Surface::Lattice {
+            island: solver::Island::Circle { diameter: 4e-4 },
+            pitch: 1.28e-3,
+            height: 3e-5,
+            offset: [0.0, 0.0],
+            lattice: solver::LatticeKind::Square,
+        };
+        let steel = solver::presets::material("steel").unwrap();
+        let with_ball = |mut c: PlannedCase, ball: Option<&solver::Material>| {
+            let name = ball.map_or("rigid", |m| m.name.as_str());
+            c.key = c.key.with_indenter(name);
+            c.spec.indenter = ball.cloned();
+            c
+        };
+        let cases = vec![
+            with_ball(aniso_case("circle-A", lattice.clone()), None),
+            with_ball(aniso_case("flat", Surface::Flat), None),
+            with_ball(aniso_case("circle-A", lattice), Some(&steel)),
+            with_ball(aniso_case("flat", Surface::Flat), Some(&steel)),
+        ];
+        let records = vec![
+            Some(record(2.5e-3, 1.4e-3, 4e-6)),
+            Some(record(2e-3, 1.5e-3, 3e-6)),
+            Some(record(2.9e-3, 1.6e-3, 5e-6)),
+            Some(record(2.4e-3, 1.7e-3, 6e-6)),
+        ];
+        let rows = calibrate(&cases, &records);
+        let ids: Vec<String> = rows.iter().map(|r| r.case.key.to_string()).collect();
+        assert_eq!(
+            ids,
+            [
+                "Cu(111)/circle-A/030.0@rigid",
+                "Cu(111)/circle-A/030.0@steel",
+                "Cu(111)/flat/030.0@rigid",
+                "Cu(111)/flat/030.0@steel",
+            ]
+        );
+        let flat_k_e = |i: usize| {
+            calibrate_k_e(
+                records[i].as_ref().unwrap().scalars.as_ref().unwrap(),
+                0.3,
+                6000.0,
+            )
+        };
+        assert_ne!(flat_k_e(1), flat_k_e(3));
+        assert_eq!(rows[0].scalars.as_ref().unwrap().k_e, flat_k_e(1));
+        assert_eq!(rows[1].scalars.as_ref().unwrap().k_e, flat_k_e(3));
+        // The CSVs name the ball after the surface.
+        let csv = results_csv(&rows);
+        assert!(
+            csv.starts_with("material,surface,indenter,angle_deg,status,"),
+            "{csv}"
+        );
+        assert!(csv.contains("\nCu(111),circle-A,steel,30,ok,"), "{csv}");
+    }
+
+    #[test]
     fn fields_dir_is_safe() {
         let d = fields_dir(Path::new("/o"), &CaseKey::new("Cu(111)", "..", 45.0));
         assert_eq!(d, Path::new("/o/fields/Cu(111)/_/045.0"));
+        let ball = CaseKey::new("Cu", "flat", 15.0).with_indenter("../x");
+        assert_eq!(
+            fields_dir(Path::new("/o"), &ball),
+            Path::new("/o/fields/Cu/flat/015.0@.._x")
+        );
+        assert_eq!(
+            fields_dir(Path::new("/o"), &ball.with_indenter("steel").at_level(1)),
+            Path::new("/o/fields/Cu/flat/015.0@steel/L1")
+        );
     }
 }
