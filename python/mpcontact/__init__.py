@@ -111,11 +111,14 @@ class Result:
         )
 
 
-def solve(cfg, material=None, surface=None, angle_deg=None):
+def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
     """Solve one case of ``cfg`` in this process (what ``mpcontact solve`` does,
     without writing files) and return a :class:`Result`.
 
     ``material``, ``surface`` and ``angle_deg`` default to the sweep's first.
+    ``indenter`` is the ball (``"rigid"``, a preset such as ``"steel"`` or a
+    ``[materials.*]`` name), like ``mpcontact solve --indenter``; it defaults
+    to the first of ``sweep.indenters``, else ``indenter.material``, else rigid.
     ``surface`` is a name (preset or ``[surfaces.*]``) or an ``(n, n)`` array
     of heights in µm, rows along y — the same as a ``shape = "heightmap"``
     surface reading that array from a ``.npy`` file.
@@ -139,7 +142,12 @@ def solve(cfg, material=None, surface=None, angle_deg=None):
     if angle_deg is not None:
         angle_deg = float(angle_deg)
     scalars, fields = _native.solve(
-        cfg, material=material, surface=name, heights=heights, angle_deg=angle_deg
+        cfg,
+        material=material,
+        surface=name,
+        heights=heights,
+        angle_deg=angle_deg,
+        indenter=indenter,
     )
     return Result(scalars, fields)
 

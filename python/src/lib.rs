@@ -168,13 +168,27 @@ impl PyConfig {
         self.sets.clone()
     }
 
-    /// The sweep's cases in the CLI's order: `(material, surface, angle_deg)`.
-    fn cases(&self) -> PyResult<Vec<(String, String, f64)>> {
+    /// The sweep's cases in the CLI's order: `(material, surface,
+    /// angle_deg)`, and `(material, surface, angle_deg, indenter)` in a
+    /// sweep over balls (`sweep.indenters`).
+    fn cases<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyTuple>>> {
         let cases = self.config.cases().map_err(value_error)?;
-        Ok(cases
+        cases
             .into_iter()
-            .map(|(k, spec)| (k.material, k.surface, spec.load.angle_deg))
-            .collect())
+            .map(|(k, spec)| {
+                let angle = spec.load.angle_deg;
+                match k.indenter {
+                    Some(ball) => (k.material, k.surface, angle, ball).into_pyobject(py),
+                    None => (k.material, k.surface, angle).into_pyobject(py),
+                }
+            })
+            .collect()
+    }
+
+    /// `sweep.indenters` (`None` without a ball axis).
+    #[getter]
+    fn indenters(&self) -> Option<Vec<String>> {
+        self.config.sweep.indenters.clone()
     }
 
     /// `sweep.materials`.
@@ -338,7 +352,8 @@ enum SurfaceArg {
 /// `case.json` as a dict, `fields` the `.npy` fields as `(n, n)` arrays.
 /// `heights` (µm, `(n, n)`, rows along y) replaces the named surface.
 #[pyfunction]
-#[pyo3(signature = (cfg, material=None, surface=None, heights=None, angle_deg=None, label="array"))]
+#[pyo3(signature = (cfg, material=None, surface=None, heights=None, angle_deg=None, label="array", indenter=None))]
+#[allow(clippy::too_many_arguments)]
 fn solve<'py>(
     py: Python<'py>,
     cfg: &PyConfig,
@@ -347,6 +362,7 @@ fn solve<'py>(
     heights: Option<PyReadonlyArray2<'py, f64>>,
     angle_deg: Option<f64>,
     label: &str,
+    indenter: Option<String>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
     let config = &cfg.config;
     let n = config.grid.points;
@@ -381,6 +397,10 @@ fn solve<'py>(
             CaseChoice::on_surface(config, material.as_deref(), label, surface, angle_deg)
         }
     }
+    .and_then(|case| match &indenter {
+        Some(name) => case.with_indenter(config, "indenter", name),
+        None => Ok(case),
+    })
     .map_err(value_error)?;
     let solved = interruptible(py, move || {
         solve_in_memory(case, solver::Threads::available())

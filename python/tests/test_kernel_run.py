@@ -101,3 +101,33 @@ def test_run_resumes_and_defaults_to_a_temporary_directory(tmp_path):
     (tmp_path / "file").write_text("")
     with pytest.raises(RuntimeError, match="not a directory"):
         mpcontact.run(cfg, workers=1, out=tmp_path / "file", progress=False)
+
+
+def test_a_sweep_over_balls_returns_a_row_per_ball(tmp_path):
+    # sweep.indenters (issue #35): one run compares balls; each row is the
+    # in-process solve of its case with its ball, to the bit.
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 64, "spacing_um": 6.0},
+            "indenter": {"radius_mm": 18.0},
+            "load": {"normal_n": 20.0, "friction": 0.28571, "tangential_ratio": 0.6},
+            "sweep": {
+                "materials": ["Fe"],
+                "angles_deg": [0, 90],
+                "indenters": ["rigid", "steel"],
+            },
+            "solver": {"coupling": False, "tolerance": 1e-10, "tangential_tolerance": 1e-6},
+        }
+    )
+    res = mpcontact.run(cfg, workers=2, out=tmp_path / "balls", progress=False)
+    r = res.results
+    assert sorted(zip(r["indenter"], r["angle_deg"])) == [
+        ("rigid", 0.0),
+        ("rigid", 90.0),
+        ("steel", 0.0),
+        ("steel", 90.0),
+    ]
+    assert list(res.curves["indenter"]) == list(r["indenter"])
+    for b, a, mu in zip(r["indenter"], r["angle_deg"], r["mu_a"]):
+        s = mpcontact.solve(cfg, angle_deg=a, indenter=str(b)).scalars
+        assert mu == s["mu_a"]

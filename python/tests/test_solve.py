@@ -231,3 +231,37 @@ def _rigid(tmp_path):
     path = tmp_path / "rigid.toml"
     path.write_text(mindlin_text(ratio=0.6))
     return mpcontact.Config.from_toml(path)
+
+
+def test_a_ball_of_the_sweep_axis_solves_from_python_as_from_the_cli(tmp_path, cli_solve):
+    # sweep.indenters (issue #35): `indenter=` picks a ball like the CLI's
+    # --indenter, the default is the axis's first, and a ball chosen so is
+    # the case of a config with indenter.material set to it, to the bit.
+    path = tmp_path / "balls.toml"
+    path.write_text(
+        mindlin_text(ratio=0.6).replace(
+            'surfaces = ["flat"]', 'surfaces = ["flat"]\nindenters = ["rigid", "steel"]'
+        )
+    )
+    cfg = mpcontact.Config.from_toml(path)
+    assert cfg.indenters == ["rigid", "steel"]
+    assert cfg.cases() == [("Fe", "flat", 0.0, "rigid"), ("Fe", "flat", 0.0, "steel")]
+    case_json, cli_dir = cli_solve(path, "--indenter", "steel")
+    res = mpcontact.solve(cfg, indenter="steel")
+    assert_same_as_cli(res, case_json, cli_dir)
+    assert res.scalars["indenter"] == "steel"
+    one = tmp_path / "steel.toml"
+    one.write_text(
+        mindlin_text(ratio=0.6).replace(
+            "radius_mm = 18.0", 'radius_mm = 18.0\nmaterial = "steel"'
+        )
+    )
+    alone = mpcontact.solve(mpcontact.Config.from_toml(one))
+    assert without_times(alone.scalars) == without_times(res.scalars)
+    first = mpcontact.solve(cfg)
+    assert first.scalars["indenter"] == "rigid"
+    assert without_times(first.scalars) == without_times(
+        mpcontact.solve(_rigid(tmp_path)).scalars
+    )
+    with pytest.raises(ValueError, match="indenter: unknown material `unobtainium`"):
+        mpcontact.solve(cfg, indenter="unobtainium")
