@@ -46,6 +46,21 @@ pub struct CaseJson<'a> {
     /// With a load history: how the dissipated energy is computed.
     #[serde(skip_serializing_if = "Option::is_none")]
     dissipation_definition: Option<&'static str>,
+    /// With a load history: the last cycle's force amplitude F*, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    force_amplitude_n: Option<f64>,
+    /// With a load history: the last cycle's shift amplitude δ*, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shift_amplitude_m: Option<f64>,
+    /// With a load history: the energy ratio A = W/(4 F* δ*) of the last cycle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy_ratio: Option<f64>,
+    /// With a load history: partial, gross or mixed slip over its cycles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    slip_regime: Option<&'a str>,
+    /// With a load history: how the slip regime is decided.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    slip_regime_definition: Option<&'static str>,
 }
 
 /// Options of `mpcontact solve`.
@@ -188,6 +203,13 @@ impl Solved {
             reversal_stiffness_n_per_m: h.and_then(|h| h.reversal_stiffness_n_per_m),
             residual_delta_t_m: h.and_then(|h| h.residual_delta_t_m),
             dissipation_definition: h.map(|_| solver::DISSIPATION_DEFINITION),
+            force_amplitude_n: h.and_then(|h| h.force_amplitude_n),
+            shift_amplitude_m: h.and_then(|h| h.shift_amplitude_m),
+            energy_ratio: h.and_then(|h| h.energy_ratio),
+            slip_regime: h.and_then(|h| h.regime.as_deref()),
+            slip_regime_definition: h
+                .and_then(|h| h.regime.as_ref())
+                .map(|_| solver::SLIP_REGIME_DEFINITION),
         }
     }
 }

@@ -76,10 +76,12 @@ fn accepted_keys() -> BTreeSet<String> {
     c.convergence = coordinator::config::ConvergenceCfg { levels: 3 };
     c.history = Some(coordinator::config::HistoryCfg {
         tangential_ratios: Some(vec![0.0, 0.5]),
+        tangential_um: Some(vec![0.0, 1.0]),
         normal_n: Some(vec![1.0, 2.0]),
         steps_per_segment: 10,
         fretting: Some(coordinator::config::FrettingCfg {
-            amplitude_ratio: 0.5,
+            amplitude_ratio: Some(0.5),
+            displacement_um: Some(1.0),
             cycles: 2,
         }),
     });

@@ -13,6 +13,7 @@ use crate::normal::{NormalProblem, NormalReport, NormalSolution};
 use crate::operator::{X, Y, Z};
 use crate::spec::CaseSpec;
 use crate::tangential::{TangentialProblem, TangentialReport, TangentialSolution, TangentialStart};
+use crate::tangential_displacement::DisplacementProblem;
 
 /// History depth of the Anderson mixing of the coupling loop.
 const ANDERSON_DEPTH: usize = 3;
@@ -125,6 +126,7 @@ pub(crate) fn solve_partial_slip(
         force: spec.load.tangential_force(),
         previous: None,
         tolerance_scale: 1.0,
+        shift: None,
     };
     solve_step(res, spec, h0, normal0, &step)
 }
@@ -149,8 +151,12 @@ pub(crate) struct Previous<'a> {
 pub(crate) struct Step<'a> {
     /// Normal load P at the end of the step, N.
     pub normal_force_n: f64,
-    /// Tangential force at the end of the step, N.
+    /// Tangential force at the end of the step, N (unused under
+    /// displacement control).
     pub force: [f64; 2],
+    /// Displacement control: the imposed increment of the ball's shift δt
+    /// over the step, m; `None`: force control.
+    pub shift: Option<[f64; 2]>,
     /// The previous increment's state; `None` from rest.
     pub previous: Option<Previous<'a>>,
     /// Factor (≥ 1) on the tangential tolerance. The solver measures its KKT
@@ -278,9 +284,23 @@ pub(crate) fn solve_step(
             };
             // From the second pass on, the last pass's tractions start the
             // solve, which takes them over (they are replaced by its own).
-            let mut tan = match last.take() {
-                Some(prev) => res.solve_tangential_from(&prob, (prev.qx, prev.qy))?,
-                None => res.solve_tangential(&prob)?,
+            let mut tan = match (step.shift, last.take()) {
+                // Displacement control: the shift is imposed, the force a result.
+                (Some(shift), pass) => res.solve_displacement(&DisplacementProblem {
+                    p: &p,
+                    friction: spec.load.friction,
+                    shift,
+                    extra: prob.extra,
+                    tolerance: tan_tol,
+                    slip_floor,
+                    max_iterations: num.max_iterations,
+                    start: match &pass {
+                        Some(t) => TangentialStart::Tractions(&t.qx, &t.qy),
+                        None => prob.start,
+                    },
+                })?,
+                (None, Some(prev)) => res.solve_tangential_from(&prob, (prev.qx, prev.qy))?,
+                (None, None) => res.solve_tangential(&prob)?,
             };
             tangential_iterations += tan.report.iterations;
             if !num.coupling || coupling_converged {
@@ -321,7 +341,14 @@ pub(crate) fn solve_step(
                 .sum::<f64>()
                 * da
                 / load;
-            rescale_slip(&mut tan, &p, &nsol.p, spec.load.friction, force);
+            // (Under displacement control the shift gives the direction.)
+            rescale_slip(
+                &mut tan,
+                &p,
+                &nsol.p,
+                spec.load.friction,
+                step.shift.unwrap_or(force),
+            );
             last = Some(tan);
             p = nsol.p;
             approach = nsol.approach;

@@ -70,7 +70,26 @@ pub struct HistoryOutput {
     pub force_error_max: f64,
     /// Dissipated energy summed over the whole path, J.
     pub dissipated_total_j: f64,
+    /// The last full cycle's force amplitude F*: the largest |F| along the
+    /// force direction over it, N.
+    #[serde(default)]
+    pub force_amplitude_n: Option<f64>,
+    /// The last full cycle's shift amplitude δ*: the largest |δt| along the
+    /// force direction over it, m.
+    #[serde(default)]
+    pub shift_amplitude_m: Option<f64>,
+    /// The energy ratio A = W / (4 F* δ*) of the last full cycle (Fouvry's
+    /// criterion: 0.2 at the transition to gross slip for a sphere).
+    #[serde(default)]
+    pub energy_ratio: Option<f64>,
+    /// The slip regime over the path's full cycles ([`SLIP_REGIME_DEFINITION`]):
+    /// `partial`, `gross`, or `mixed` when it changes between cycles.
+    #[serde(default)]
+    pub regime: Option<String>,
 }
+
+/// How [`HistoryOutput::regime`] is decided.
+pub const SLIP_REGIME_DEFINITION: &str = "a full cycle is in gross slip when at some increment of it no contact cell sticks (every traction on its friction disc: the whole contact slides), in partial slip otherwise; the path is `partial` or `gross` when all its full cycles are, `mixed` when they differ";
 
 /// Sums of the solves over all increments.
 pub(crate) struct HistoryState {
@@ -125,6 +144,7 @@ pub(crate) fn solve_history(
     let angle = spec.load.angle_deg.to_radians();
     let dir = [angle.cos(), angle.sin()];
     let points = history.turning_points(&spec.load);
+    let displacement_control = history.displacement_controlled();
     let steps = history.steps_per_segment;
 
     // State after frictionless normal loading.
@@ -223,7 +243,18 @@ pub(crate) fn solve_history(
                     ..NormalProblem::new(h0, p_k)
                 })?
             };
-            let force = [f_k * dir[0], f_k * dir[1]];
+            // Force control: the force at the increment's end; displacement
+            // control: the shift still to impose to reach the target, the
+            // force a result.
+            let (force, shift) = if displacement_control {
+                let target = [f_k * dir[0], f_k * dir[1]];
+                (
+                    [0.0; 2],
+                    Some([target[0] - delta_t[0], target[1] - delta_t[1]]),
+                )
+            } else {
+                ([f_k * dir[0], f_k * dir[1]], None)
+            };
             // The KKT tolerance relative to the loop's δt (see Step::tolerance_scale),
             // with the last increment's |Δδt| as the estimate of this one's.
             let tolerance_scale = if last_increment > 0.0 {
@@ -249,6 +280,7 @@ pub(crate) fn solve_history(
                         p0: &p0,
                     }),
                     tolerance_scale,
+                    shift,
                 },
             )?;
             check(&state.p)?;
@@ -294,8 +326,10 @@ pub(crate) fn solve_history(
                     converged: step_converged,
                 },
             );
-            let ferr = (r.force_n[0] - force[0]).hypot(r.force_n[1] - force[1]) / (mu * p_k);
-            force_error_max = force_error_max.max(ferr);
+            if !displacement_control {
+                let ferr = (r.force_n[0] - force[0]).hypot(r.force_n[1] - force[1]) / (mu * p_k);
+                force_error_max = force_error_max.max(ferr);
+            }
             rows.push(r);
             (ux, uy) = (vx, vy);
             last = state;
@@ -423,6 +457,46 @@ fn reduce_history(
             })
         });
     let dissipated_total_j = steps.iter().map(|r| r.dissipated_j).sum();
+    // Amplitudes and the energy ratio of the last cycle.
+    let (force_amplitude_n, shift_amplitude_m, energy_ratio) = match (cycle, dissipated) {
+        (Some((s0, s1)), Some(w)) => {
+            let rows = &steps[s0..=s1];
+            let f = rows
+                .iter()
+                .map(|r| along(r.force_n).abs())
+                .fold(0.0, f64::max);
+            let d = rows
+                .iter()
+                .map(|r| along(r.delta_t_m).abs())
+                .fold(0.0, f64::max);
+            let ratio = (f > 0.0 && d > 0.0).then(|| w / (4.0 * f * d));
+            (Some(f), Some(d), ratio)
+        }
+        _ => (None, None, None),
+    };
+    // The regime of every full cycle, from the last one back.
+    let mut regimes = Vec::new();
+    let mut j = cycle.map(|(s0, _)| turning_steps.iter().position(|&t| t == s0));
+    while let Some(Some(k)) = j {
+        if k + 2 >= points.len() || !same(points[k], points[k + 2]) {
+            break;
+        }
+        let (s0, s1) = (turning_steps[k], turning_steps[k + 2]);
+        let gross = steps[s0 + 1..=s1]
+            .iter()
+            .any(|r| r.stick_area_m2 == 0.0 && r.contact_area_m2 > 0.0);
+        regimes.push(gross);
+        j = (k >= 2).then(|| Some(k - 2));
+    }
+    let regime = (!regimes.is_empty()).then(|| {
+        if regimes.iter().all(|&g| g) {
+            "gross".to_string()
+        } else if regimes.iter().all(|&g| !g) {
+            "partial".to_string()
+        } else {
+            "mixed".to_string()
+        }
+    });
     HistoryOutput {
         direction: dir,
         steps,
@@ -433,5 +507,9 @@ fn reduce_history(
         residual_delta_t_m: residual,
         force_error_max,
         dissipated_total_j,
+        force_amplitude_n,
+        shift_amplitude_m,
+        energy_ratio,
+        regime,
     }
 }

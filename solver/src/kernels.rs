@@ -171,6 +171,19 @@ impl Resident {
         solve_normal(&mut self.operator, &mut self.normal, prob)
     }
 
+    /// [`crate::tangential_displacement::solve_displacement`] on this bundle.
+    pub fn solve_displacement(
+        &mut self,
+        prob: &crate::tangential_displacement::DisplacementProblem,
+    ) -> Result<TangentialSolution, SolverError> {
+        crate::progress::stage(Stage::Tangential);
+        crate::tangential_displacement::solve_displacement(
+            &mut self.operator,
+            &mut self.windows,
+            prob,
+        )
+    }
+
     /// [`solve_tangential`] on this bundle.
     pub fn solve_tangential(
         &mut self,

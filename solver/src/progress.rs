@@ -259,6 +259,7 @@ mod tests {
                 tangential_ratios: vec![0.6, -0.6],
                 normal_forces_n: None,
                 steps_per_segment: 2,
+                shifts_m: None,
             }),
             ..small_case()
         };

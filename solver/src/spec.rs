@@ -100,20 +100,44 @@ pub struct LoadHistory {
     pub normal_forces_n: Option<Vec<f64>>,
     /// Increments per segment between turning points.
     pub steps_per_segment: usize,
+    /// Displacement control (as fretting rigs run): the turning points of
+    /// the ball's rigid tangential shift along the force direction, m
+    /// (signed), measured from the end of the frictionless normal loading
+    /// against the far field of the substrate. When given, they replace
+    /// `tangential_ratios` (which must be empty), the force is a result, and
+    /// the contact may slide as a whole (gross slip).
+    #[serde(default)]
+    pub shifts_m: Option<Vec<f64>>,
 }
 
 impl LoadHistory {
-    /// The turning points as (P, F along the force direction) in N,
-    /// starting from zero tangential force.
+    /// True when the turning points are shifts of the ball (`shifts_m`).
+    pub fn displacement_controlled(&self) -> bool {
+        self.shifts_m.is_some()
+    }
+
+    /// The number of turning points given.
+    fn count(&self) -> usize {
+        self.shifts_m
+            .as_ref()
+            .map_or(self.tangential_ratios.len(), Vec::len)
+    }
+
+    /// The turning points as (P in N, the tangential target along the force
+    /// direction: F in N, or the ball's shift in m under displacement
+    /// control), starting from zero tangential force (shift).
     pub fn turning_points(&self, load: &Load) -> Vec<(f64, f64)> {
         let normal = |j: usize| match &self.normal_forces_n {
             Some(v) => v[j],
             None => load.normal_force_n,
         };
-        let mut pts: Vec<(f64, f64)> = (0..self.tangential_ratios.len())
+        let mut pts: Vec<(f64, f64)> = (0..self.count())
             .map(|j| {
                 let p = normal(j);
-                (p, self.tangential_ratios[j] * load.friction * p)
+                match &self.shifts_m {
+                    Some(d) => (p, d[j]),
+                    None => (p, self.tangential_ratios[j] * load.friction * p),
+                }
             })
             .collect();
         if let Some(&(p0, f0)) = pts.first() {
@@ -126,12 +150,33 @@ impl LoadHistory {
 
     /// Rejects impossible paths, naming `history.<key>[index]`.
     pub fn validate(&self) -> Result<(), SolverError> {
-        let n = self.tangential_ratios.len();
+        let n = self.count();
+        let key = if self.displacement_controlled() {
+            "history.shifts_m"
+        } else {
+            "history.tangential_ratios"
+        };
         if n == 0 {
             return Err(SolverError::invalid(
-                "history.tangential_ratios",
+                key,
                 "needs at least one turning point",
             ));
+        }
+        if let Some(d) = &self.shifts_m {
+            if !self.tangential_ratios.is_empty() {
+                return Err(SolverError::invalid(
+                    "history.shifts_m",
+                    "give the turning points either as forces (tangential_ratios) or as shifts, not both",
+                ));
+            }
+            for (j, &v) in d.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(SolverError::invalid(
+                        &format!("history.shifts_m[{j}]"),
+                        format!("must be finite, got {v} m"),
+                    ));
+                }
+            }
         }
         for (j, &r) in self.tangential_ratios.iter().enumerate() {
             if !r.is_finite() {
@@ -155,7 +200,7 @@ impl LoadHistory {
                 return Err(SolverError::invalid(
                     "history.normal_forces_n",
                     format!(
-                        "has {} turning points but history.tangential_ratios has {n}; give one normal load per turning point",
+                        "has {} turning points but {key} has {n}; give one normal load per turning point",
                         v.len()
                     ),
                 ));

@@ -71,6 +71,7 @@ fn fretting(n: usize, spacing_um: f64, amplitude: f64, cycles: usize, steps: usi
             tangential_ratios: ratios,
             normal_forces_n: None,
             steps_per_segment: steps,
+            shifts_m: None,
         }),
         ..table_1a_fe(n, spacing_um, false, amplitude)
     }
@@ -200,6 +201,7 @@ fn proportional_loading_below_mu_leaves_no_slip() {
         tangential_ratios: vec![ratio, ratio],
         normal_forces_n: Some(vec![P / 8.0, P]),
         steps_per_segment: 20,
+        shifts_m: None,
     });
     let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
     let h = out.scalars.history.as_ref().unwrap();
@@ -277,6 +279,7 @@ fn quick_fretting(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
             tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
             normal_forces_n: None,
             steps_per_segment: 10,
+            shifts_m: None,
         }),
         indenter: None,
     }

@@ -478,6 +478,7 @@ fn solver_history(
         tangential_ratios: vec![0.0, 0.0],
         normal_forces_n: Some(vec![first, last]),
         steps_per_segment: steps,
+        shifts_m: None,
     });
     solve_case(&spec, &mut KernelCache::new()).expect("the history solves")
 }

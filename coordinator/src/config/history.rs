@@ -16,6 +16,10 @@ pub struct HistoryCfg {
     /// joined by straight lines.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tangential_ratios: Option<Vec<f64>>,
+    /// Turning points of the ball's tangential shift along the case's force
+    /// angle (signed), µm: displacement control (issue #37).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_um: Option<Vec<f64>>,
     /// Normal load at each turning point, N (default: `load.normal_n` throughout).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub normal_n: Option<Vec<f64>>,
@@ -27,12 +31,18 @@ pub struct HistoryCfg {
     pub fretting: Option<FrettingCfg>,
 }
 
-/// `history.fretting`: a fretting loop of amplitude A = `amplitude_ratio` μP.
+/// `history.fretting`: a fretting loop of force amplitude A =
+/// `amplitude_ratio` μP, or of the ball's shift amplitude `displacement_um`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrettingCfg {
     /// Amplitude of the tangential force, as a fraction of μP (0 < A < 1).
-    pub amplitude_ratio: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude_ratio: Option<f64>,
+    /// Amplitude of the ball's tangential shift, µm (> 0): displacement
+    /// control, into gross slip when it exceeds what the stick zone holds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement_um: Option<f64>,
     /// Full cycles after the first loading (+A → −A → +A each).
     #[serde(default = "one_cycle")]
     pub cycles: usize,
@@ -52,37 +62,81 @@ pub const MAX_CYCLES: usize = 1000;
 impl HistoryCfg {
     /// The solver's load path; errors name the config key.
     pub fn load_history(&self) -> Result<LoadHistory> {
+        let given = [
+            self.tangential_ratios.is_some(),
+            self.tangential_um.is_some(),
+            self.fretting.is_some(),
+        ];
+        if given.iter().filter(|&&g| g).count() > 1 {
+            bail!(
+                "history: give one of tangential_ratios, tangential_um or fretting = {{ amplitude_ratio | displacement_um, cycles }}, not several"
+            );
+        }
+        if let Some(d) = &self.tangential_um {
+            return Ok(LoadHistory {
+                tangential_ratios: Vec::new(),
+                normal_forces_n: self.normal_n.clone(),
+                steps_per_segment: self.steps_per_segment,
+                shifts_m: Some(d.iter().map(|v| v * 1e-6).collect()),
+            });
+        }
+        if let Some(f) = &self.fretting {
+            if let Some(d) = f.displacement_um {
+                if f.amplitude_ratio.is_some() {
+                    bail!("history.fretting: give amplitude_ratio (force control) or displacement_um (displacement control), not both");
+                }
+                if !(d.is_finite() && d > 0.0) {
+                    bail!("history.fretting.displacement_um = {d}: must be positive and finite (the amplitude of the ball's shift, µm)");
+                }
+                let shifts = self.fretting_path(f, d * 1e-6)?;
+                return Ok(LoadHistory {
+                    tangential_ratios: Vec::new(),
+                    normal_forces_n: None,
+                    steps_per_segment: self.steps_per_segment,
+                    shifts_m: Some(shifts),
+                });
+            }
+        }
         let ratios = match (&self.tangential_ratios, &self.fretting) {
-            (Some(_), Some(_)) => bail!(
-                "history: give either tangential_ratios or fretting = {{ amplitude_ratio, cycles }}, not both"
-            ),
             (None, None) => bail!(
-                "history: give the turning points (tangential_ratios = [0.0, 0.6, -0.6, 0.6]) or fretting = {{ amplitude_ratio = 0.6, cycles = 2 }}"
+                "history: give the turning points (tangential_ratios = [0.0, 0.6, -0.6, 0.6], or tangential_um = [0.0, 1.5, -1.5, 1.5]) or fretting = {{ amplitude_ratio = 0.6, cycles = 2 }} (or {{ displacement_um = 1.5, cycles = 2 }})"
             ),
-            (Some(r), None) => r.clone(),
+            (Some(r), _) => r.clone(),
             (None, Some(f)) => {
-                let a = f.amplitude_ratio;
+                let Some(a) = f.amplitude_ratio else {
+                    bail!("history.fretting: give amplitude_ratio (a fraction of μP) or displacement_um (µm)");
+                };
                 if !(a.is_finite() && a > 0.0 && a < 1.0) {
                     bail!("history.fretting.amplitude_ratio = {a}: must be above 0 and below 1 (the amplitude as a fraction of μP; at 1 the sphere slides)");
                 }
-                if !(1..=MAX_CYCLES).contains(&f.cycles) {
-                    bail!("history.fretting.cycles = {}: must be 1 to {MAX_CYCLES}", f.cycles);
-                }
-                if self.normal_n.is_some() {
-                    bail!("history.normal_n: not with the fretting shorthand (its normal load is load.normal_n); give tangential_ratios instead");
-                }
-                let mut r = vec![0.0, a];
-                for _ in 0..f.cycles {
-                    r.extend([-a, a]);
-                }
-                r
+                self.fretting_path(f, a)?
             }
         };
         Ok(LoadHistory {
             tangential_ratios: ratios,
             normal_forces_n: self.normal_n.clone(),
             steps_per_segment: self.steps_per_segment,
+            shifts_m: None,
         })
+    }
+
+    /// The fretting shorthand's path 0 → +a → −a → +a … of `f.cycles`
+    /// full cycles (a a force ratio or a shift).
+    fn fretting_path(&self, f: &FrettingCfg, a: f64) -> Result<Vec<f64>> {
+        if !(1..=MAX_CYCLES).contains(&f.cycles) {
+            bail!(
+                "history.fretting.cycles = {}: must be 1 to {MAX_CYCLES}",
+                f.cycles
+            );
+        }
+        if self.normal_n.is_some() {
+            bail!("history.normal_n: not with the fretting shorthand (its normal load is load.normal_n); give tangential_ratios or tangential_um instead");
+        }
+        let mut r = vec![0.0, a];
+        for _ in 0..f.cycles {
+            r.extend([-a, a]);
+        }
+        Ok(r)
     }
 }
 
@@ -96,6 +150,9 @@ impl Config {
 
 /// The config key of a solver parameter of the load path.
 pub(super) fn config_key(param: &str) -> Option<String> {
+    if let Some(rest) = param.strip_prefix("history.shifts_m") {
+        return Some(format!("history.tangential_um{rest}"));
+    }
     param
         .strip_prefix("history.normal_forces_n")
         .map(|rest| format!("history.normal_n{rest}"))
@@ -166,5 +223,51 @@ mod tests {
             .1
             .history
             .is_none());
+    }
+
+    #[test]
+    fn issue37_displacement_controlled_paths_and_their_errors() {
+        let with = |h: &str| format!("{BASE}\n[history]\n{h}\n");
+        let cases: [(&str, &str); 5] = [
+            (
+                "tangential_um = [0.0, 1.0]\ntangential_ratios = [0.0, 0.5]",
+                "history: give one of tangential_ratios, tangential_um or fretting",
+            ),
+            (
+                "fretting = { displacement_um = 1.0, amplitude_ratio = 0.5 }",
+                "history.fretting: give amplitude_ratio (force control) or displacement_um",
+            ),
+            (
+                "fretting = { displacement_um = -1.0 }",
+                "history.fretting.displacement_um = -1: must be positive",
+            ),
+            (
+                "tangential_um = [0.0, nan]",
+                "invalid history.tangential_um[1]: must be finite",
+            ),
+            (
+                "tangential_um = [0.0, 1.0]\nnormal_n = [20.0]",
+                "history.normal_n: has 1 turning points but history.shifts_m has 2",
+            ),
+        ];
+        for (h, expect) in cases {
+            let e = err(&with(h), &[]);
+            assert!(e.contains(expect), "{h}: {e}");
+        }
+        // The shorthand in µm expands to shifts in m; the force is a result,
+        // so the case's own tangential ratio is 0.
+        let c = Config::parse(
+            &with("fretting = { displacement_um = 1.5, cycles = 1 }"),
+            &[],
+        )
+        .unwrap();
+        let h = c.load_history().unwrap();
+        assert!(h.tangential_ratios.is_empty());
+        let d = h.shifts_m.clone().unwrap();
+        assert_eq!(d.len(), 4);
+        assert!((d[1] - 1.5e-6).abs() < 1e-18 && (d[2] + 1.5e-6).abs() < 1e-18);
+        let (_, spec) = &c.cases().unwrap()[0];
+        assert_eq!(spec.load.tangential_ratio, 0.0);
+        assert!(spec.history.as_ref().unwrap().displacement_controlled());
     }
 }
