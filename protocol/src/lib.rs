@@ -56,7 +56,12 @@ pub use wire::{
 /// of the wire layout; a message carrying another version is rejected.
 ///
 /// 2: the case identity is a caller-chosen key type `K` (was a `case_id` string).
-pub const PROTOCOL_VERSION: u32 = 2;
+/// 3: the payloads the coordinator sends carry an elastic ball
+/// (`CaseSpec::indenter`, `CaseKey::indenter`) and displacement-controlled
+/// load paths (`LoadHistory::shifts_m`), and results the cycle's amplitudes,
+/// energy ratio and slip regime: a worker of another build is refused
+/// cleanly instead of misreading them.
+pub const PROTOCOL_VERSION: u32 = 3;
 
 #[cfg(test)]
 mod tests;
