@@ -46,7 +46,9 @@
 //! 3. description of a case: `material`, `surface`, `presets`, `spec`
 //! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables)
 //! 5. single-field solvers: `normal`; `tangential_problem` (the tangential
-//!    solve's inputs and outputs) → `coarse_slip` → `window` → `tangential`
+//!    solve's inputs and outputs) and `fista` (the shared momentum step) →
+//!    `coarse_slip` → `window` → `tangential`, `tangential_displacement`
+//!    (the shift imposed instead of the force)
 //! 6. resident kernels: `kernels` (an operator with the caches the solvers
 //!    of layer 5 made for it, hence after them)
 //! 7. load steps: `coupling` (one step, the coupling loop), `history` (a
@@ -61,6 +63,7 @@ mod coupling;
 mod error;
 #[doc(hidden)]
 pub mod fft2;
+mod fista;
 #[doc(hidden)]
 pub mod geometry;
 mod grid;

@@ -15,6 +15,7 @@
 
 use crate::coarse_slip::{coarse_start, TangentialLevels};
 use crate::error::SolverError;
+use crate::fista::Momentum;
 use crate::operator::Operator;
 pub use crate::tangential_problem::{
     TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
@@ -372,7 +373,7 @@ fn on_grid_taking(
     // Accelerated projected gradient (FISTA) with gradient-based adaptive restart
     // (O'Donoghue & Candès 2015) on min ½qᵀCq + eᵀq over {discs} ∩ {force}.
     // The projection's multiplier λ is the rigid shift: δt = λ / step.
-    let mut t_k = 1.0_f64;
+    let mut momentum = Momentum::new();
     for it in 1..=fista_budget {
         crate::progress::tick_or_cancel()?;
         report.iterations = cg.iterations + it;
@@ -394,24 +395,13 @@ fn on_grid_taking(
             restart_dot += dx * (px[i] - qx[i]) + dy * (py[i] - qy[i]);
         }
         report.change = res / step / shift_norm;
-        let t_next = if restart_dot > 0.0 {
-            1.0
-        } else {
-            0.5 * (1.0 + (1.0 + 4.0 * t_k * t_k).sqrt())
-        };
-        let mom = if restart_dot > 0.0 {
-            0.0
-        } else {
-            (t_k - 1.0) / t_next
-        };
-        t_k = t_next;
-        for &i in &cells {
-            let (ox, oy) = (qx[i], qy[i]);
-            qx[i] = px[i];
-            qy[i] = py[i];
-            yx[i] = px[i] + mom * (px[i] - ox);
-            yy[i] = py[i] + mom * (py[i] - oy);
-        }
+        momentum.advance(
+            restart_dot > 0.0,
+            &cells,
+            (&mut qx, &mut qy),
+            (&px, &py),
+            (&mut yx, &mut yy),
+        );
         if report.change < prob.tolerance {
             report.converged = true;
             break;

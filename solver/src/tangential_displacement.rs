@@ -15,6 +15,7 @@
 //! traction sits on its rim: gross slip, F = μP on a flat Coulomb surface.
 
 use crate::error::SolverError;
+use crate::fista::Momentum;
 use crate::operator::Operator;
 use crate::tangential_problem::{TangentialReport, TangentialSolution, TangentialStart};
 use crate::window::{contact_window, WindowCache};
@@ -139,7 +140,7 @@ pub fn solve_displacement_on_grid(
         }
     };
     let mut report = TangentialReport::default();
-    let mut t_k = 1.0_f64;
+    let mut momentum = Momentum::new();
     for it in 1..=prob.max_iterations {
         crate::progress::tick_or_cancel()?;
         report.iterations = it;
@@ -154,21 +155,13 @@ pub fn solve_displacement_on_grid(
         }
         // The gradient mapping (a slip) relative to the scale.
         report.change = res / step / scale;
-        let restart = restart_dot > 0.0;
-        let t_next = if restart {
-            1.0
-        } else {
-            0.5 * (1.0 + (1.0 + 4.0 * t_k * t_k).sqrt())
-        };
-        let mom = if restart { 0.0 } else { (t_k - 1.0) / t_next };
-        t_k = t_next;
-        for &i in &cells {
-            let (ox, oy) = (qx[i], qy[i]);
-            qx[i] = px[i];
-            qy[i] = py[i];
-            yx[i] = px[i] + mom * (px[i] - ox);
-            yy[i] = py[i] + mom * (py[i] - oy);
-        }
+        momentum.advance(
+            restart_dot > 0.0,
+            &cells,
+            (&mut qx, &mut qy),
+            (&px, &py),
+            (&mut yx, &mut yy),
+        );
         if report.change < prob.tolerance {
             report.converged = true;
             break;

@@ -1,0 +1,44 @@
+//! The momentum step of accelerated projected gradient (FISTA) with
+//! gradient-based adaptive restart (O'Donoghue & Candès 2015), shared by the
+//! force-controlled tangential solver's fallback phase and the
+//! displacement-controlled solver: one definition of the arithmetic, so both
+//! stay the method they say they are.
+
+/// Nesterov's sequence t_k of a FISTA iteration.
+pub(crate) struct Momentum(f64);
+
+impl Momentum {
+    /// t₁ = 1.
+    pub(crate) fn new() -> Self {
+        Momentum(1.0)
+    }
+
+    /// Takes the projected point `p` as the new iterate `q` and extrapolates
+    /// `y = p + β (p − q_old)` on `cells`, with β = (t_k − 1)/t_{k+1}; a
+    /// restart (the last step went against the gradient mapping) sets β = 0
+    /// and t back to 1.
+    pub(crate) fn advance(
+        &mut self,
+        restart: bool,
+        cells: &[usize],
+        (qx, qy): (&mut [f64], &mut [f64]),
+        (px, py): (&[f64], &[f64]),
+        (yx, yy): (&mut [f64], &mut [f64]),
+    ) {
+        let t_k = self.0;
+        let t_next = if restart {
+            1.0
+        } else {
+            0.5 * (1.0 + (1.0 + 4.0 * t_k * t_k).sqrt())
+        };
+        let mom = if restart { 0.0 } else { (t_k - 1.0) / t_next };
+        self.0 = t_next;
+        for &i in cells {
+            let (ox, oy) = (qx[i], qy[i]);
+            qx[i] = px[i];
+            qy[i] = py[i];
+            yx[i] = px[i] + mom * (px[i] - ox);
+            yy[i] = py[i] + mom * (py[i] - oy);
+        }
+    }
+}
