@@ -37,24 +37,47 @@ pub struct CaseKey {
     /// before balls read as `None`.
     #[serde(default)]
     pub indenter: Option<String>,
+    /// The normal load of a sweep over loads (`sweep.normal_loads_n`), N.
+    /// `None` without that axis; serialised like `indenter`.
+    #[serde(default)]
+    pub normal_n: Option<f64>,
+    /// The displacement amplitude of a fretting map (`sweep.amplitudes_um`),
+    /// µm. `None` without that axis; serialised like `indenter`.
+    #[serde(default)]
+    pub amplitude_um: Option<f64>,
 }
 
 impl Serialize for CaseKey {
     /// Every field, in order, for bincode (not self-describing: a field
     /// left out could not be read back); in a human-readable format (the
-    /// journal's JSON) `indenter` only when there is one, so a key without
-    /// a ball writes the line it wrote before balls existed.
+    /// journal's JSON) the axes `indenter`, `normal_n` and `amplitude_um`
+    /// only when there is one, so a key without them writes the line it
+    /// wrote before those axes existed.
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let omit = s.is_human_readable() && self.indenter.is_none();
-        let mut st = s.serialize_struct("CaseKey", if omit { 4 } else { 5 })?;
+        let readable = s.is_human_readable();
+        let ball = !(readable && self.indenter.is_none());
+        let load = !(readable && self.normal_n.is_none());
+        let amp = !(readable && self.amplitude_um.is_none());
+        let n = 4 + [ball, load, amp].iter().filter(|&&b| b).count();
+        let mut st = s.serialize_struct("CaseKey", n)?;
         st.serialize_field("material", &self.material)?;
         st.serialize_field("surface", &self.surface)?;
         st.serialize_field("angle_deg", &self.angle_deg)?;
         st.serialize_field("level", &self.level)?;
-        if omit {
-            st.skip_field("indenter")?;
-        } else {
+        if ball {
             st.serialize_field("indenter", &self.indenter)?;
+        } else {
+            st.skip_field("indenter")?;
+        }
+        if load {
+            st.serialize_field("normal_n", &self.normal_n)?;
+        } else {
+            st.skip_field("normal_n")?;
+        }
+        if amp {
+            st.serialize_field("amplitude_um", &self.amplitude_um)?;
+        } else {
+            st.skip_field("amplitude_um")?;
         }
         st.end()
     }
@@ -69,7 +92,37 @@ impl CaseKey {
             angle_deg,
             level: 0,
             indenter: None,
+            normal_n: None,
+            amplitude_um: None,
         }
+    }
+
+    /// The same case at the normal load `normal_n` (N) of a sweep over loads.
+    pub fn with_normal_load(mut self, normal_n: f64) -> Self {
+        self.normal_n = Some(normal_n);
+        self
+    }
+
+    /// The same case at the displacement amplitude `amplitude_um` (µm) of a
+    /// fretting map.
+    pub fn with_amplitude(mut self, amplitude_um: f64) -> Self {
+        self.amplitude_um = Some(amplitude_um);
+        self
+    }
+
+    /// The fretting-map axes as they appear in ids and paths: `@6000N` for
+    /// a normal load, `@1.5um` for an amplitude (shortest text that reads
+    /// back to the same number, so distinct values give distinct ids);
+    /// empty without those axes.
+    pub fn axes_text(&self) -> String {
+        let mut t = String::new();
+        if let Some(p) = self.normal_n {
+            t.push_str(&format!("@{p}N"));
+        }
+        if let Some(a) = self.amplitude_um {
+            t.push_str(&format!("@{a}um"));
+        }
+        t
     }
 
     /// The same case pressed by the ball `name` of a sweep over balls
@@ -98,8 +151,9 @@ impl CaseKey {
 
 impl fmt::Display for CaseKey {
     /// `material/surface/angle`, e.g. `Cu(111)/circle-A/015.0`, with
-    /// `@ball` appended in a sweep over balls (`Cu/flat/000.0@steel`) and
-    /// `/L2` on ladder level 2 (`Cu/flat/000.0@steel/L2`).
+    /// `@ball` appended in a sweep over balls (`Cu/flat/000.0@steel`), the
+    /// fretting-map axes after it (`Cu/flat/000.0@6000N@1.5um`, see
+    /// [`CaseKey::axes_text`]) and `/L2` on ladder level 2 (`Cu/flat/000.0@steel/L2`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
@@ -111,6 +165,7 @@ impl fmt::Display for CaseKey {
         if let Some(ball) = &self.indenter {
             write!(f, "@{ball}")?;
         }
+        write!(f, "{}", self.axes_text())?;
         if self.level > 0 {
             write!(f, "/L{}", self.level)?;
         }
@@ -207,6 +262,32 @@ mod tests {
         assert_eq!(serde_json::from_str::<CaseKey>(&text).unwrap(), k);
         assert_ne!(k, CaseKey::new("Cu", "flat", 0.0).with_indenter("rigid"));
         assert_ne!(k, CaseKey::new("Cu", "flat", 0.0));
+    }
+
+    #[test]
+    fn issue37_map_axes_show_in_the_id_and_only_then_in_json() {
+        let k = CaseKey::new("Cu", "flat", 0.0)
+            .with_normal_load(6000.0)
+            .with_amplitude(1.5);
+        assert_eq!(k.to_string(), "Cu/flat/000.0@6000N@1.5um");
+        let a = CaseKey::new("Cu", "flat", 0.0)
+            .with_indenter("steel")
+            .with_amplitude(0.25);
+        assert_eq!(a.to_string(), "Cu/flat/000.0@steel@0.25um");
+        let text = serde_json::to_string(&a).unwrap();
+        assert!(
+            text.ends_with(r#""indenter":"steel","amplitude_um":0.25}"#),
+            "{text}"
+        );
+        assert_eq!(serde_json::from_str::<CaseKey>(&text).unwrap(), a);
+        let text = serde_json::to_string(&k).unwrap();
+        assert_eq!(serde_json::from_str::<CaseKey>(&text).unwrap(), k);
+        for k in [k, a] {
+            let env = protocol::Envelope::new("run", (k.clone(), 7u32));
+            let bytes = protocol::encode_to_vec(&env, &[]).unwrap();
+            let back = protocol::decode::<(CaseKey, u32)>(&bytes, "run").unwrap();
+            assert_eq!(back.header.body, (k, 7));
+        }
     }
 
     #[test]

@@ -101,10 +101,16 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     );
     let shown: Vec<String> = angles.iter().map(|a| format!("{a}")).collect();
     let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
-    let ball_axis = match &config.sweep.indenters {
+    let mut ball_axis = match &config.sweep.indenters {
         Some(names) => format!(" x {} balls", names.len()),
         None => String::new(),
     };
+    if let Some(v) = &config.sweep.normal_loads_n {
+        ball_axis.push_str(&format!(" x {} normal loads", v.len()));
+    }
+    if let Some(v) = &config.sweep.amplitudes_um {
+        ball_axis.push_str(&format!(" x {} amplitudes", v.len()));
+    }
     let _ = writeln!(
         s,
         "cases:     {} = {} materials x {} surfaces x {} angles{ball_axis} x {levels} level(s)",

@@ -69,6 +69,8 @@ fn accepted_keys() -> BTreeSet<String> {
     c.surfaces.insert("NAME".into(), surface);
     c.indenter.material = Some("steel".into());
     c.sweep.indenters = Some(vec!["rigid".into(), "steel".into()]);
+    c.sweep.normal_loads_n = Some(vec![10.0, 20.0]);
+    c.sweep.amplitudes_um = Some(vec![1.0, 2.0]);
     c.run = RunCfg {
         case_timeout_s: 5.0,
     };

@@ -1450,3 +1450,86 @@ fn issue35_a_ball_axis_runs_every_ball_and_matches_the_one_ball_sweeps() {
     );
     assert!(shm_leftovers("b").is_empty());
 }
+
+/// A one-line fretting map on isotropic Cu, flat (64², R = 200 mm, P = 6000
+/// N, μ = 0.3): δ* = 3μP(2 − ν)/(16aG) ≈ 6.4 µm.
+const MAP_CONFIG: &str = r#"
+[grid]
+points = 64
+spacing_um = 120.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["flat"]
+angles_deg = [0]
+amplitudes_um = [3.0, 12.0]
+
+[solver]
+coupling = false
+
+[history]
+fretting = { cycles = 1 }
+steps_per_segment = 5
+"#;
+
+#[test]
+fn issue37_fretting_map_rows_regimes_and_transition() {
+    let dir = scratch("fretting-map");
+    std::fs::write(dir.join("sweep.toml"), MAP_CONFIG).unwrap();
+    check_ok(
+        &sweep_cmd(&dir, "out", 2, "fm").output().unwrap(),
+        "fretting map",
+    );
+    let o = dir.join("out");
+    let ids: BTreeSet<String> = journal_cases(&o)
+        .iter()
+        .map(|v| v["case_id"].as_str().unwrap().to_string())
+        .collect();
+    let want: BTreeSet<String> = ["Cu/flat/000.0@3um", "Cu/flat/000.0@12um"]
+        .map(String::from)
+        .into();
+    assert_eq!(ids, want);
+    let map = read_csv(&o.join("fretting_map.csv"));
+    assert_eq!(map[0].join(","), coordinator::run::FRETTING_MAP_HEADER);
+    assert_eq!(map.len(), 3, "{map:?}");
+    let col = |name: &str| map[0].iter().position(|h| h == name).unwrap();
+    let (amp, regime, ratio) = (col("amplitude_um"), col("regime"), col("energy_ratio"));
+    assert_eq!(map[1][amp], "3");
+    assert_eq!(map[2][amp], "12");
+    assert_eq!(map[1][col("normal_n")], "6000");
+    assert_eq!(map[1][regime], "partial", "{map:?}");
+    assert_eq!(map[2][regime], "gross", "{map:?}");
+    for r in &map[1..] {
+        assert_eq!(r[col("status")], "ok");
+        let w: f64 = r[col("dissipated_j")].parse().unwrap();
+        assert!(w > 0.0, "{r:?}");
+    }
+    let a: Vec<f64> = map[1..].iter().map(|r| r[ratio].parse().unwrap()).collect();
+    assert!(a[0] < 0.2 && a[1] > 0.2, "energy ratios {a:?}");
+    // The transition: within the bracket, by A = 0.2.
+    let t = read_csv(&o.join("fretting_transitions.csv"));
+    assert_eq!(t[0].join(","), coordinator::run::TRANSITIONS_HEADER);
+    assert_eq!(t.len(), 2, "{t:?}");
+    let tc = |name: &str| t[0].iter().position(|h| h == name).unwrap();
+    let at: f64 = t[1][tc("transition_um")].parse().unwrap();
+    assert!(at > 3.0 && at < 12.0, "{t:?}");
+    assert_eq!(t[1][tc("last_partial_um")], "3");
+    assert_eq!(t[1][tc("first_gross_um")], "12");
+    assert_eq!(t[1][tc("method")], "energy_ratio");
+    for f in ["fretting_map.png", "fretting_map.svg"] {
+        assert!(std::fs::metadata(o.join(f)).unwrap().len() > 0, "{f}");
+    }
+    // results.csv names the amplitude after the surface.
+    assert_eq!(
+        read_csv(&o.join("results.csv"))[0].join(","),
+        coordinator::run::RESULTS_HEADER.replacen("surface,", "surface,amplitude_um,", 1)
+    );
+    assert!(o.join("fields/Cu/flat/000.0@12um").is_dir());
+}

@@ -178,15 +178,20 @@ class RunResult:
     ``curves``: ``curves.csv`` the same way. ``summary``: the run's tallies
     and timings (summary.json without the config echo). ``out``: the output
     directory with every file ``mpcontact run`` writes.
+    ``fretting_map`` and ``fretting_transitions``: ``fretting_map.csv`` and
+    ``fretting_transitions.csv`` the same way in a sweep with
+    ``sweep.amplitudes_um`` (a fretting map), ``None`` otherwise.
     """
 
-    __slots__ = ("results", "curves", "summary", "out")
+    __slots__ = ("results", "curves", "summary", "out", "fretting_map", "fretting_transitions")
 
-    def __init__(self, results, curves, summary, out):
+    def __init__(self, results, curves, summary, out, fretting_map=None, fretting_transitions=None):
         self.results = results
         self.curves = curves
         self.summary = summary
         self.out = out
+        self.fretting_map = fretting_map
+        self.fretting_transitions = fretting_transitions
 
     def __repr__(self):
         s = self.summary
@@ -226,6 +231,8 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
         curves=_read_csv(out / "curves.csv"),
         summary=summary,
         out=out,
+        fretting_map=_read_csv_if(out / "fretting_map.csv"),
+        fretting_transitions=_read_csv_if(out / "fretting_transitions.csv"),
     )
 
 
@@ -243,6 +250,11 @@ def _worker_command():
         "from mpcontact._worker import main; main()".format(parent)
     )
     return sys.executable, ["-c", code]
+
+
+def _read_csv_if(path):
+    """:func:`_read_csv` of ``path`` if the run wrote it, else ``None``."""
+    return _read_csv(path) if path.exists() else None
 
 
 def _read_csv(path):

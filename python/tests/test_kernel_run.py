@@ -131,3 +131,25 @@ def test_a_sweep_over_balls_returns_a_row_per_ball(tmp_path):
     for b, a, mu in zip(r["indenter"], r["angle_deg"], r["mu_a"]):
         s = mpcontact.solve(cfg, angle_deg=a, indenter=str(b)).scalars
         assert mu == s["mu_a"]
+
+
+def test_a_fretting_map_returns_its_table(tmp_path):
+    # sweep.amplitudes_um (issue #37): run() reads fretting_map.csv and
+    # fretting_transitions.csv as the CLI writes them.
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 64, "spacing_um": 120.0},
+            "indenter": {"radius_mm": 200.0},
+            "load": {"normal_n": 6000.0, "friction": 0.3},
+            "sweep": {"materials": ["Cu"], "angles_deg": [0], "amplitudes_um": [3.0, 12.0]},
+            "solver": {"coupling": False},
+            "history": {"fretting": {"cycles": 1}, "steps_per_segment": 5},
+        }
+    )
+    res = mpcontact.run(cfg, workers=2, out=tmp_path / "map", progress=False)
+    m = res.fretting_map
+    assert list(m["amplitude_um"]) == [3.0, 12.0]
+    assert list(m["regime"]) == ["partial", "gross"]
+    t = res.fretting_transitions["transition_um"]
+    assert 3.0 < t[0] < 12.0
+    assert (res.out / "fretting_map.png").exists()

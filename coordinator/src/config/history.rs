@@ -62,6 +62,13 @@ pub const MAX_CYCLES: usize = 1000;
 impl HistoryCfg {
     /// The solver's load path; errors name the config key.
     pub fn load_history(&self) -> Result<LoadHistory> {
+        self.load_history_at(None)
+    }
+
+    /// The load path of one case of a fretting map: `amplitude_um` (the
+    /// case's entry of `sweep.amplitudes_um`) is the displacement amplitude
+    /// of `fretting = { cycles = N }`; `None` outside a map.
+    pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
         let given = [
             self.tangential_ratios.is_some(),
             self.tangential_um.is_some(),
@@ -71,6 +78,24 @@ impl HistoryCfg {
             bail!(
                 "history: give one of tangential_ratios, tangential_um or fretting = {{ amplitude_ratio | displacement_um, cycles }}, not several"
             );
+        }
+        if let Some(a) = amplitude_um {
+            let Some(f) = self.fretting.as_ref().filter(|_| given[2]) else {
+                bail!("sweep.amplitudes_um: needs [history] fretting = {{ cycles = N }} (displacement control; the axis gives each case's amplitude), not turning points");
+            };
+            if f.displacement_um.is_some() {
+                bail!("history.fretting.displacement_um and sweep.amplitudes_um both set the displacement amplitude: leave displacement_um out (the axis gives each case's)");
+            }
+            if f.amplitude_ratio.is_some() {
+                bail!("history.fretting.amplitude_ratio is force control, sweep.amplitudes_um displacement control: leave amplitude_ratio out");
+            }
+            let shifts = self.fretting_path(f, a * 1e-6)?;
+            return Ok(LoadHistory {
+                tangential_ratios: Vec::new(),
+                normal_forces_n: None,
+                steps_per_segment: self.steps_per_segment,
+                shifts_m: Some(shifts),
+            });
         }
         if let Some(d) = &self.tangential_um {
             return Ok(LoadHistory {
@@ -104,7 +129,7 @@ impl HistoryCfg {
             (Some(r), _) => r.clone(),
             (None, Some(f)) => {
                 let Some(a) = f.amplitude_ratio else {
-                    bail!("history.fretting: give amplitude_ratio (a fraction of μP) or displacement_um (µm)");
+                    bail!("history.fretting: give amplitude_ratio (a fraction of μP) or displacement_um (µm), or the amplitudes as sweep.amplitudes_um");
                 };
                 if !(a.is_finite() && a > 0.0 && a < 1.0) {
                     bail!("history.fretting.amplitude_ratio = {a}: must be above 0 and below 1 (the amplitude as a fraction of μP; at 1 the sphere slides)");
@@ -144,7 +169,15 @@ impl Config {
     /// The load path of `[history]`, if any. A malformed one gives `None`
     /// here; [`Config::check`] reports it by key before any case is made.
     pub fn load_history(&self) -> Option<LoadHistory> {
-        self.history.as_ref().and_then(|h| h.load_history().ok())
+        self.load_history_at(self.sweep.amplitude_axis()[0])
+    }
+
+    /// The load path of a case at `amplitude_um` of `sweep.amplitudes_um`
+    /// (`None` outside a fretting map).
+    pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Option<LoadHistory> {
+        self.history
+            .as_ref()
+            .and_then(|h| h.load_history_at(amplitude_um).ok())
     }
 }
 

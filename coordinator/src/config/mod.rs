@@ -199,8 +199,18 @@ impl Config {
         self.run.check()?;
         self.sweep.check_unique(&self.sweep.angles_deg.values()?)?;
         self.convergence.check()?;
-        if let Some(h) = &self.history {
-            h.load_history()?;
+        let amplitude = self.sweep.amplitude_axis()[0];
+        match &self.history {
+            Some(h) => {
+                h.load_history_at(amplitude)?;
+                if self.sweep.normal_loads_n.is_some() && h.normal_n.is_some() {
+                    bail!("history.normal_n and sweep.normal_loads_n both set the normal load: leave history.normal_n out (the axis gives each case's)");
+                }
+            }
+            None if amplitude.is_some() => bail!(
+                "sweep.amplitudes_um: needs [history] fretting = {{ cycles = N }} (displacement control; the axis gives each case's amplitude)"
+            ),
+            None => {}
         }
         // Whether the workers fit in this machine's memory is checked where
         // they start (`memory::check_fits`), not here.
@@ -223,6 +233,7 @@ impl Config {
             self.surface(surface)?,
             angle_deg,
             self.default_ball()?,
+            self.default_map_point(),
         ))
     }
 
@@ -234,19 +245,29 @@ impl Config {
             surface,
             angle_deg,
             self.default_ball()?,
+            self.default_map_point(),
         ))
     }
 
+    /// The normal load and amplitude a single case gets when none is
+    /// chosen: the first of `sweep.normal_loads_n` and `sweep.amplitudes_um`
+    /// (`None` without the axis).
+    pub fn default_map_point(&self) -> (Option<f64>, Option<f64>) {
+        (self.sweep.load_axis()[0], self.sweep.amplitude_axis()[0])
+    }
+
     /// The spec of a resolved material and surface at one angle, pressed by
-    /// the resolved ball `indenter` (`None`: rigid).
+    /// the resolved ball `indenter` (`None`: rigid), at the fretting-map
+    /// point `(normal load N, amplitude µm)` (`None`s: the config's).
     fn spec_of(
         &self,
         material: Material,
         surface: Surface,
         angle_deg: f64,
         indenter: Option<Material>,
+        (normal_n, amplitude_um): (Option<f64>, Option<f64>),
     ) -> CaseSpec {
-        let history = self.load_history();
+        let history = self.load_history_at(amplitude_um);
         // With a load path, the case's own ratio is the path's last one (its
         // final state is reduced like a monotonic case: μa, K_E calibration).
         let tangential_ratio = match &history {
@@ -257,7 +278,13 @@ impl Config {
             material,
             surface,
             grid: self.level_grid(0),
-            load: self.load_at(tangential_ratio, angle_deg),
+            load: {
+                let mut load = self.load_at(tangential_ratio, angle_deg);
+                if let Some(p) = normal_n {
+                    load.normal_force_n = p;
+                }
+                load
+            },
             numerics: self.solver.numerics(),
             history,
             indenter,
@@ -265,7 +292,7 @@ impl Config {
     }
 
     /// All cases of the sweep in a fixed order: materials × surfaces × angles
-    /// × balls (× ladder levels, finest last). Each material, surface and
+    /// × balls × normal loads × amplitudes (× ladder levels, finest last). Each material, surface and
     /// ball is resolved once. Without `sweep.indenters` there is one ball
     /// and the keys carry none (the cases of before).
     pub fn cases(&self) -> Result<Vec<(CaseKey, CaseSpec)>> {
@@ -285,17 +312,35 @@ impl Config {
             })
             .collect::<Result<Vec<_>>>()?;
         let balls = self.balls()?;
+        let loads = self.sweep.load_axis();
+        let amplitudes = self.sweep.amplitude_axis();
+        let mut points = Vec::new();
+        for b in &balls {
+            for &p in &loads {
+                for &d in &amplitudes {
+                    points.push((b, p, d));
+                }
+            }
+        }
         let mut out = Vec::new();
         for m in &self.sweep.materials {
             let material = self.material(m)?;
             for (s, surface) in &surfaces {
                 for &a in &angles {
-                    for (name, ball) in &balls {
-                        let key = match name {
+                    for &((name, ball), p, d) in &points {
+                        let mut key = match name {
                             Some(name) => CaseKey::new(m, s, a).with_indenter(name),
                             None => CaseKey::new(m, s, a),
                         };
-                        let spec = self.spec_of(material.clone(), surface.clone(), a, ball.clone());
+                        key.normal_n = p;
+                        key.amplitude_um = d;
+                        let spec = self.spec_of(
+                            material.clone(),
+                            surface.clone(),
+                            a,
+                            ball.clone(),
+                            (p, d),
+                        );
                         let finer: Vec<_> = (1..self.convergence.levels)
                             .map(|level| {
                                 let grid = self.level_grid(level);

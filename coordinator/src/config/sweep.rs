@@ -144,6 +144,17 @@ pub struct SweepCfg {
     /// resume) as before.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indenters: Option<Vec<String>>,
+    /// Normal loads to sweep (`sweep.normal_loads_n`), N: each case once per
+    /// load, which replaces `load.normal_n`. Absent: no load axis. Not
+    /// written back when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_loads_n: Option<Vec<f64>>,
+    /// Displacement amplitudes of a fretting map (`sweep.amplitudes_um`),
+    /// µm: each case once per amplitude, the amplitude of `[history]
+    /// fretting = { cycles = N }` (displacement control). Absent: no
+    /// amplitude axis. Not written back when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitudes_um: Option<Vec<f64>>,
 }
 
 /// The name that means "no ball" in `sweep.indenters`.
@@ -169,7 +180,54 @@ impl SweepCfg {
         if self.indenters.as_ref().is_some_and(Vec::is_empty) {
             bail!("sweep.indenters: list at least one ball (`{RIGID}` for a rigid one), or leave the key out");
         }
+        for (key, values, what) in [
+            (
+                "sweep.normal_loads_n",
+                &self.normal_loads_n,
+                "normal load, N",
+            ),
+            (
+                "sweep.amplitudes_um",
+                &self.amplitudes_um,
+                "displacement amplitude, µm",
+            ),
+        ] {
+            let Some(values) = values else { continue };
+            if values.is_empty() {
+                bail!("{key}: list at least one {what}, or leave the key out");
+            }
+            if let Some((i, v)) = values
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+            {
+                bail!("{key}[{i}] = {v}: must be positive and finite (a {what})");
+            }
+            let mut seen = Vec::new();
+            for v in values {
+                if seen.contains(v) {
+                    bail!("{key}: {v} is listed twice; every case must be unique");
+                }
+                seen.push(*v);
+            }
+        }
         Ok(())
+    }
+
+    /// The normal loads of the load axis (`None`: no axis, one load).
+    pub fn load_axis(&self) -> Vec<Option<f64>> {
+        match &self.normal_loads_n {
+            Some(v) => v.iter().copied().map(Some).collect(),
+            None => vec![None],
+        }
+    }
+
+    /// The amplitudes of the amplitude axis (`None`: no axis).
+    pub fn amplitude_axis(&self) -> Vec<Option<f64>> {
+        match &self.amplitudes_um {
+            Some(v) => v.iter().copied().map(Some).collect(),
+            None => vec![None],
+        }
     }
 
     /// Every case must have its own identity: no material, surface or ball
@@ -328,6 +386,119 @@ mod tests {
             .unwrap()
             .to_toml()
             .contains("indenters"));
+    }
+
+    #[test]
+    fn issue37_map_axes_errors_name_the_key() {
+        let axes = |lists: &str, history: &str| {
+            format!(
+                "{}\n[history]\n{history}\n",
+                BASE.replace(
+                    "surfaces = [\"flat\"]",
+                    &format!("surfaces = [\"flat\"]\n{lists}")
+                )
+            )
+        };
+        let cycles = "fretting = { cycles = 1 }";
+        let cases: [(String, &str); 10] = [
+            (
+                axes("amplitudes_um = []", cycles),
+                "sweep.amplitudes_um: list at least one",
+            ),
+            (
+                axes("amplitudes_um = [1.0, -2.0]", cycles),
+                "sweep.amplitudes_um[1] = -2: must be positive and finite",
+            ),
+            (
+                axes("amplitudes_um = [1.0, 1.0]", cycles),
+                "sweep.amplitudes_um: 1 is listed twice",
+            ),
+            (
+                axes("amplitudes_um = [1.0]\nnormal_loads_n = [0.0]", cycles),
+                "sweep.normal_loads_n[0] = 0: must be positive",
+            ),
+            (
+                axes("normal_loads_n = [10.0, 10.0]", cycles),
+                "sweep.normal_loads_n: 10 is listed twice",
+            ),
+            (
+                BASE.replace(
+                    "surfaces = [\"flat\"]",
+                    "surfaces = [\"flat\"]\namplitudes_um = [1.0]",
+                ),
+                "sweep.amplitudes_um: needs [history] fretting = { cycles = N }",
+            ),
+            (
+                axes("amplitudes_um = [1.0]", "tangential_um = [0.0, 1.0]"),
+                "sweep.amplitudes_um: needs [history] fretting = { cycles = N }",
+            ),
+            (
+                axes(
+                    "amplitudes_um = [1.0]",
+                    "fretting = { displacement_um = 1.0, cycles = 1 }",
+                ),
+                "history.fretting.displacement_um and sweep.amplitudes_um both set",
+            ),
+            (
+                axes(
+                    "amplitudes_um = [1.0]",
+                    "fretting = { amplitude_ratio = 0.5, cycles = 1 }",
+                ),
+                "history.fretting.amplitude_ratio is force control",
+            ),
+            (
+                axes(
+                    "normal_loads_n = [10.0]",
+                    "tangential_ratios = [0.0, 0.5]\nnormal_n = [20.0, 20.0]",
+                ),
+                "history.normal_n and sweep.normal_loads_n both set",
+            ),
+        ];
+        for (text, expect) in cases {
+            let e = err(&text, &[]);
+            assert!(e.contains(expect), "{expect}: {e}");
+        }
+        // Without the axis, fretting = { cycles } alone says where the
+        // amplitude goes.
+        let e = err(&axes("", cycles), &[]);
+        assert!(
+            e.contains("or the amplitudes as sweep.amplitudes_um"),
+            "{e}"
+        );
+        // A good map: loads × amplitudes per angle, each with its own path.
+        let c = Config::parse(
+            &axes(
+                "angles_deg = [0.0]\nnormal_loads_n = [10.0, 20.0]\namplitudes_um = [0.5, 1.5]",
+                "fretting = { cycles = 2 }",
+            )
+            .replace("angles_deg = { start = 0, stop = 90, step = 45 }\n", ""),
+            &[],
+        )
+        .unwrap();
+        let cases = c.cases().unwrap();
+        let ids: Vec<String> = cases.iter().map(|(k, _)| k.to_string()).collect();
+        assert_eq!(
+            ids,
+            [
+                "Fe/flat/000.0@10N@0.5um",
+                "Fe/flat/000.0@10N@1.5um",
+                "Fe/flat/000.0@20N@0.5um",
+                "Fe/flat/000.0@20N@1.5um",
+            ]
+        );
+        assert_eq!(cases[2].1.load.normal_force_n, 20.0);
+        let h = cases[1].1.history.as_ref().unwrap();
+        assert_eq!(
+            h.shifts_m.as_ref().unwrap(),
+            &[0.0, 1.5e-6, -1.5e-6, 1.5e-6, -1.5e-6, 1.5e-6]
+        );
+        assert!(c.to_toml().contains("amplitudes_um"));
+        assert!(!Config::parse(BASE, &[])
+            .unwrap()
+            .to_toml()
+            .contains("amplitudes_um"));
+        // `solve`'s single case: the axes' first values.
+        assert_eq!(c.spec("Fe", "flat", 0.0).unwrap().load.normal_force_n, 10.0);
     }
 
     #[test]

@@ -11,6 +11,7 @@
 
 mod dispatch;
 mod exchange;
+mod fretting_map;
 mod journal;
 mod lock;
 mod merge;
@@ -28,6 +29,7 @@ use anyhow::Context;
 use serde::Serialize;
 
 pub use exchange::Interrupted;
+pub use fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
 pub use output::{CURVES_HEADER, RESULTS_HEADER};
@@ -248,11 +250,31 @@ fn write_outputs(
         if let Some(ball) = &key.indenter {
             title.push_str(&format!(", {ball} ball"));
         }
+        if let Some(n) = key.normal_n {
+            title.push_str(&format!(", P = {n} N"));
+        }
+        if let Some(a) = key.amplitude_um {
+            title.push_str(&format!(", Δ = {a} µm"));
+        }
         match crate::history_out::write_history(&output::fields_dir(dir, key), h, &title) {
             Ok(warnings) => summary.output_warnings.extend(warnings),
             Err(e) => summary
                 .output_warnings
                 .push(format!("history of {key}: {e:#}")),
+        }
+    }
+    // A fretting map (sweep.amplitudes_um): its table, transitions, figure.
+    let map = fretting_map::map_points(&rows);
+    if !map.is_empty() {
+        write("fretting_map.csv", fretting_map::fretting_map_csv(&map))?;
+        write(
+            "fretting_transitions.csv",
+            fretting_map::transitions_csv(&map),
+        )?;
+        for name in ["fretting_map.png", "fretting_map.svg"] {
+            if let Err(e) = fretting_map::plot_map(&dir.join(name), &map) {
+                summary.output_warnings.push(format!("{name}: {e:#}"));
+            }
         }
     }
     for name in ["mu_a_vs_angle.png", "mu_a_vs_angle.svg"] {

@@ -29,25 +29,64 @@ pub const CURVES_HEADER: &str =
 /// that axis has the headers above, to the byte.
 pub const INDENTER_COLUMN: &str = "indenter";
 
-/// `header` with [`INDENTER_COLUMN`] after `surface` when `balls`.
-fn header_with_balls(header: &str, balls: bool) -> String {
-    if balls {
-        header.replacen(
-            "material,surface,",
-            &format!("material,surface,{INDENTER_COLUMN},"),
-            1,
-        )
-    } else {
-        header.to_string()
+/// The columns a fretting map's sweep axes add after `surface` (and the
+/// ball): `normal_n` with `sweep.normal_loads_n`, `amplitude_um` with
+/// `sweep.amplitudes_um`.
+pub const NORMAL_COLUMN: &str = "normal_n";
+/// See [`NORMAL_COLUMN`].
+pub const AMPLITUDE_COLUMN: &str = "amplitude_um";
+
+/// Which identity axes beyond material × surface × angle a sweep has (each
+/// adds a column after `surface`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Axes {
+    balls: bool,
+    loads: bool,
+    amplitudes: bool,
+}
+
+impl Axes {
+    fn of<'a>(keys: impl Iterator<Item = &'a CaseKey>) -> Self {
+        let mut a = Axes::default();
+        for k in keys {
+            a.balls |= k.indenter.is_some();
+            a.loads |= k.normal_n.is_some();
+            a.amplitudes |= k.amplitude_um.is_some();
+        }
+        a
     }
 }
 
+/// `header` with the axes' columns after `surface`.
+fn header_with_axes(header: &str, axes: Axes) -> String {
+    let mut cols = String::from("material,surface,");
+    for (on, name) in [
+        (axes.balls, INDENTER_COLUMN),
+        (axes.loads, NORMAL_COLUMN),
+        (axes.amplitudes, AMPLITUDE_COLUMN),
+    ] {
+        if on {
+            cols.push_str(name);
+            cols.push(',');
+        }
+    }
+    header.replacen("material,surface,", &cols, 1)
+}
+
 /// The cells that name a case's curve: `material,surface,` and, in a sweep
-/// over balls, the ball.
-fn identity_cells(key: &CaseKey, balls: bool) -> String {
+/// over balls, loads or amplitudes, those.
+fn identity_cells(key: &CaseKey, axes: Axes) -> String {
     let mut cells = format!("{},{},", csv_field(&key.material), csv_field(&key.surface));
-    if balls {
+    if axes.balls {
         cells.push_str(&csv_field(key.indenter.as_deref().unwrap_or_default()));
+        cells.push(',');
+    }
+    if axes.loads {
+        cells.push_str(&opt(key.normal_n));
+        cells.push(',');
+    }
+    if axes.amplitudes {
+        cells.push_str(&opt(key.amplitude_um));
         cells.push(',');
     }
     cells
@@ -107,8 +146,8 @@ fn opt(v: Option<f64>) -> String {
 
 /// Text of `results.csv` (with [`INDENTER_COLUMN`] in a sweep over balls).
 pub fn results_csv(rows: &[Row]) -> String {
-    let balls = rows.iter().any(|r| r.case.key.indenter.is_some());
-    let mut out = header_with_balls(RESULTS_HEADER, balls);
+    let axes = Axes::of(rows.iter().map(|r| &r.case.key));
+    let mut out = header_with_axes(RESULTS_HEADER, axes);
     out.push('\n');
     for r in rows {
         let c = r.case;
@@ -118,7 +157,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         let _ = writeln!(
             out,
             "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
-            identity_cells(&c.key, balls),
+            identity_cells(&c.key, axes),
             fmt_f64(c.spec.load.angle_deg),
             r.record.status,
             opt(s.and_then(|s| s.mu_a)),
@@ -245,8 +284,8 @@ pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
 /// per cycle).
 pub fn curves_csv(points: &[CurvePoint]) -> String {
     let history = points.iter().any(|p| p.dissipated.is_some());
-    let balls = points.iter().any(|p| p.key.indenter.is_some());
-    let mut out = header_with_balls(CURVES_HEADER, balls);
+    let axes = Axes::of(points.iter().map(|p| &p.key));
+    let mut out = header_with_axes(CURVES_HEADER, axes);
     if history {
         out.push(',');
         out.push_str(CURVES_HISTORY_COLUMNS);
@@ -257,7 +296,7 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
         let _ = write!(
             out,
             "{}{},{},{},{},{},{},{},{},{}",
-            identity_cells(&p.key, balls),
+            identity_cells(&p.key, axes),
             fmt_f64(p.key.angle_deg),
             fmt_f64(p.mu_a.value),
             opt(p.mu_a.err),
@@ -308,10 +347,16 @@ type CurveId<'a> = (&'a str, String);
 fn by_curve(points: &[CurvePoint]) -> BTreeMap<CurveId<'_>, Vec<&CurvePoint>> {
     let mut m: BTreeMap<CurveId<'_>, Vec<&CurvePoint>> = BTreeMap::new();
     for p in points {
-        let surface = match &p.key.indenter {
+        let mut surface = match &p.key.indenter {
             Some(ball) => format!("{} @ {ball}", p.key.surface),
             None => p.key.surface.clone(),
         };
+        if let Some(n) = p.key.normal_n {
+            surface.push_str(&format!(" @ {n} N"));
+        }
+        if let Some(a) = p.key.amplitude_um {
+            surface.push_str(&format!(" @ {a} µm"));
+        }
         m.entry((p.key.material.as_str(), surface))
             .or_default()
             .push(p);
@@ -615,9 +660,10 @@ pub fn fields_dir(out_dir: &Path, key: &CaseKey) -> PathBuf {
     };
     p.push(safe(&key.material));
     p.push(safe(&key.surface));
+    let axes = key.axes_text();
     match &key.indenter {
-        Some(ball) => p.push(format!("{}@{}", key.angle_text(), safe(ball))),
-        None => p.push(safe(&key.angle_text())),
+        Some(ball) => p.push(format!("{}@{}{axes}", key.angle_text(), safe(ball))),
+        None => p.push(format!("{}{axes}", key.angle_text())),
     }
     // Level 0 keeps the directory it had before ladders existed.
     if key.level > 0 {
