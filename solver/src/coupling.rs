@@ -123,10 +123,9 @@ pub(crate) fn solve_partial_slip(
 ) -> Result<ContactState, SolverError> {
     let step = Step {
         normal_force_n: spec.load.normal_force_n,
-        force: spec.load.tangential_force(),
+        target: Target::Force(spec.load.tangential_force()),
         previous: None,
         tolerance_scale: 1.0,
-        shift: None,
     };
     solve_step(res, spec, h0, normal0, &step)
 }
@@ -145,18 +144,34 @@ pub(crate) struct Previous<'a> {
     pub p0: &'a [f64],
 }
 
+/// What a step imposes tangentially.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Target {
+    /// The tangential force at the step's end, N (force control).
+    Force([f64; 2]),
+    /// The increment of the ball's rigid shift δt over the step, m
+    /// (displacement control: the force is a result, and the contact may
+    /// slide as a whole).
+    Shift([f64; 2]),
+}
+
+impl Target {
+    /// The imposed vector (its direction is the loading direction).
+    fn vector(self) -> [f64; 2] {
+        match self {
+            Target::Force(v) | Target::Shift(v) => v,
+        }
+    }
+}
+
 /// The load of one solve: one monotonic step from rest (`previous: None`,
 /// the case of §5 of PHYSICS.md) or one increment of a load history from
 /// the previous increment's state (§5b).
 pub(crate) struct Step<'a> {
     /// Normal load P at the end of the step, N.
     pub normal_force_n: f64,
-    /// Tangential force at the end of the step, N (unused under
-    /// displacement control).
-    pub force: [f64; 2],
-    /// Displacement control: the imposed increment of the ball's shift δt
-    /// over the step, m; `None`: force control.
-    pub shift: Option<[f64; 2]>,
+    /// The tangential force or shift the step imposes.
+    pub target: Target,
     /// The previous increment's state; `None` from rest.
     pub previous: Option<Previous<'a>>,
     /// Factor (≥ 1) on the tangential tolerance. The solver measures its KKT
@@ -192,8 +207,12 @@ pub(crate) fn solve_step(
     let mut approach = normal0.approach;
     let mut p = normal0.p;
     drop(normal0.uz);
-    let force = step.force;
-    let fnorm = force[0].hypot(force[1]);
+    let force = match step.target {
+        Target::Force(f) => f,
+        Target::Shift(_) => [0.0; 2],
+    };
+    let drive = step.target.vector();
+    let fnorm = drive[0].hypot(drive[1]);
     let previous = step.previous.as_ref();
 
     // The last pass's tangential solution (none before the first pass).
@@ -284,9 +303,9 @@ pub(crate) fn solve_step(
             };
             // From the second pass on, the last pass's tractions start the
             // solve, which takes them over (they are replaced by its own).
-            let mut tan = match (step.shift, last.take()) {
+            let mut tan = match (step.target, last.take()) {
                 // Displacement control: the shift is imposed, the force a result.
-                (Some(shift), pass) => res.solve_displacement(&DisplacementProblem {
+                (Target::Shift(shift), pass) => res.solve_displacement(&DisplacementProblem {
                     p: &p,
                     friction: spec.load.friction,
                     shift,
@@ -299,8 +318,10 @@ pub(crate) fn solve_step(
                         None => prob.start,
                     },
                 })?,
-                (None, Some(prev)) => res.solve_tangential_from(&prob, (prev.qx, prev.qy))?,
-                (None, None) => res.solve_tangential(&prob)?,
+                (Target::Force(_), Some(prev)) => {
+                    res.solve_tangential_from(&prob, (prev.qx, prev.qy))?
+                }
+                (Target::Force(_), None) => res.solve_tangential(&prob)?,
             };
             tangential_iterations += tan.report.iterations;
             if !num.coupling || coupling_converged {
@@ -341,14 +362,7 @@ pub(crate) fn solve_step(
                 .sum::<f64>()
                 * da
                 / load;
-            // (Under displacement control the shift gives the direction.)
-            rescale_slip(
-                &mut tan,
-                &p,
-                &nsol.p,
-                spec.load.friction,
-                step.shift.unwrap_or(force),
-            );
+            rescale_slip(&mut tan, &p, &nsol.p, spec.load.friction, drive);
             last = Some(tan);
             p = nsol.p;
             approach = nsol.approach;

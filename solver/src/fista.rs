@@ -4,6 +4,25 @@
 //! displacement-controlled solver: one definition of the arithmetic, so both
 //! stay the method they say they are.
 
+/// The gradient mapping of a FISTA step from `y` to its projection `p` on
+/// `cells`: the largest |y − p| (a traction; divided by the step it is a
+/// slip), and whether the step went against the last move `p − q`, which
+/// restarts the momentum.
+pub(crate) fn mapping(
+    cells: &[usize],
+    (yx, yy): (&[f64], &[f64]),
+    (px, py): (&[f64], &[f64]),
+    (qx, qy): (&[f64], &[f64]),
+) -> (f64, bool) {
+    let (mut res, mut restart_dot) = (0.0_f64, 0.0);
+    for &i in cells {
+        let (dx, dy) = (yx[i] - px[i], yy[i] - py[i]);
+        res = res.max(dx.hypot(dy));
+        restart_dot += dx * (px[i] - qx[i]) + dy * (py[i] - qy[i]);
+    }
+    (res, restart_dot > 0.0)
+}
+
 /// Nesterov's sequence t_k of a FISTA iteration.
 pub(crate) struct Momentum(f64);
 

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::coupling::{solve_step, ContactState, Previous, Step};
+use crate::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::error::SolverError;
 use crate::geometry::{equivalent_radius, subcell_hull_area};
 use crate::kernels::Resident;
@@ -246,14 +246,11 @@ pub(crate) fn solve_history(
             // Force control: the force at the increment's end; displacement
             // control: the shift still to impose to reach the target, the
             // force a result.
-            let (force, shift) = if displacement_control {
-                let target = [f_k * dir[0], f_k * dir[1]];
-                (
-                    [0.0; 2],
-                    Some([target[0] - delta_t[0], target[1] - delta_t[1]]),
-                )
+            let goal = [f_k * dir[0], f_k * dir[1]];
+            let target = if displacement_control {
+                Target::Shift([goal[0] - delta_t[0], goal[1] - delta_t[1]])
             } else {
-                ([f_k * dir[0], f_k * dir[1]], None)
+                Target::Force(goal)
             };
             // The KKT tolerance relative to the loop's δt (see Step::tolerance_scale),
             // with the last increment's |Δδt| as the estimate of this one's.
@@ -273,14 +270,13 @@ pub(crate) fn solve_history(
                 normal,
                 &Step {
                     normal_force_n: p_k,
-                    force,
+                    target,
                     previous: Some(Previous {
                         start,
                         u: (&ux, &uy),
                         p0: &p0,
                     }),
                     tolerance_scale,
-                    shift,
                 },
             )?;
             check(&state.p)?;
@@ -327,7 +323,7 @@ pub(crate) fn solve_history(
                 },
             );
             if !displacement_control {
-                let ferr = (r.force_n[0] - force[0]).hypot(r.force_n[1] - force[1]) / (mu * p_k);
+                let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
                 force_error_max = force_error_max.max(ferr);
             }
             rows.push(r);

@@ -15,7 +15,7 @@
 
 use crate::coarse_slip::{coarse_start, TangentialLevels};
 use crate::error::SolverError;
-use crate::fista::Momentum;
+use crate::fista::{self, Momentum};
 use crate::operator::Operator;
 pub use crate::tangential_problem::{
     TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
@@ -388,15 +388,10 @@ fn on_grid_taking(
         let shift_norm = (lambda[0].hypot(lambda[1]) / step)
             .max(prob.slip_floor)
             .max(f64::MIN_POSITIVE);
-        let (mut res, mut restart_dot) = (0.0_f64, 0.0);
-        for &i in &cells {
-            let (dx, dy) = (yx[i] - px[i], yy[i] - py[i]);
-            res = res.max(dx.hypot(dy));
-            restart_dot += dx * (px[i] - qx[i]) + dy * (py[i] - qy[i]);
-        }
+        let (res, restart) = fista::mapping(&cells, (&yx, &yy), (&px, &py), (&qx, &qy));
         report.change = res / step / shift_norm;
         momentum.advance(
-            restart_dot > 0.0,
+            restart,
             &cells,
             (&mut qx, &mut qy),
             (&px, &py),

@@ -15,7 +15,7 @@
 //! traction sits on its rim: gross slip, F = μP on a flat Coulomb surface.
 
 use crate::error::SolverError;
-use crate::fista::Momentum;
+use crate::fista::{self, Momentum};
 use crate::operator::Operator;
 use crate::tangential_problem::{TangentialReport, TangentialSolution, TangentialStart};
 use crate::window::{contact_window, WindowCache};
@@ -103,13 +103,8 @@ pub fn solve_displacement_on_grid(
 ) -> Result<TangentialSolution, SolverError> {
     let len = op.grid().len();
     let p = prob.p;
+    // (μ is checked with the case, `CaseSpec::validate`.)
     let mu = prob.friction;
-    if !(mu.is_finite() && mu >= 0.0) {
-        return Err(SolverError::invalid(
-            "load.friction",
-            format!("the friction coefficient must be finite and ≥ 0, got {mu}"),
-        ));
-    }
     let cells: Vec<usize> = (0..len).filter(|&i| p[i] > 0.0).collect();
     let bound = |i: usize| mu * p[i];
     let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
@@ -146,17 +141,14 @@ pub fn solve_displacement_on_grid(
         report.iterations = it;
         report.applications += 1;
         slip(op, &yx, &yy, &mut sx, &mut sy);
-        let (mut res, mut restart_dot) = (0.0_f64, 0.0);
         for &i in &cells {
             (px[i], py[i]) = clip(yx[i] - step * sx[i], yy[i] - step * sy[i], bound(i));
-            let (dx, dy) = (yx[i] - px[i], yy[i] - py[i]);
-            res = res.max(dx.hypot(dy));
-            restart_dot += dx * (px[i] - qx[i]) + dy * (py[i] - qy[i]);
         }
         // The gradient mapping (a slip) relative to the scale.
+        let (res, restart) = fista::mapping(&cells, (&yx, &yy), (&px, &py), (&qx, &qy));
         report.change = res / step / scale;
         momentum.advance(
-            restart_dot > 0.0,
+            restart,
             &cells,
             (&mut qx, &mut qy),
             (&px, &py),

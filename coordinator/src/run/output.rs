@@ -744,13 +744,7 @@ mod tests {
 
     #[test]
     fn anisotropic_mu_a_uses_k_e_from_the_flat_twin() {
-        let lattice = Surface::Lattice {
-            island: solver::Island::Circle { diameter: 4e-4 },
-            pitch: 1.28e-3,
-            height: 3e-5,
-            offset: [0.0, 0.0],
-            lattice: solver::LatticeKind::Square,
-        };
+        let lattice = solver::presets::surface("circle-A").expect("a preset");
         let flat = aniso_case("flat", Surface::Flat);
         let pat = aniso_case("circle-A", lattice);
         assert!(flat.calibration && !pat.calibration);
@@ -780,13 +774,7 @@ mod tests {
 
     #[test]
     fn issue35_each_ball_calibrates_on_its_own_flat_twin() {
-        let lattice = Surface::Lattice {
-            island: solver::Island::Circle { diameter: 4e-4 },
-            pitch: 1.28e-3,
-            height: 3e-5,
-            offset: [0.0, 0.0],
-            lattice: solver::LatticeKind::Square,
-        };
+        let lattice = solver::presets::surface("circle-A").expect("a preset");
         let steel = solver::presets::material("steel").unwrap();
         let with_ball = |mut c: PlannedCase, ball: Option<&solver::Material>| {
             let name = ball.map_or("rigid", |m| m.name.as_str());
