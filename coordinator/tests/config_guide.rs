@@ -63,7 +63,7 @@ fn accepted_keys() -> BTreeSet<String> {
         },
     );
     let surface: SurfaceCfg = toml::from_str(
-        "shape = 'circle'\ndiameter_um = 1.0\nside_um = 1.0\nwidth_um = 1.0\npitch_um = 2.0\nheight_um = 1.0\nlattice = 'square'\nangle_deg = 0.0\nfile = 'x.npy'\n",
+        "shape = 'circle'\ndiameter_um = 1.0\nside_um = 1.0\nwidth_um = 1.0\npitch_um = 2.0\nheight_um = 1.0\nlattice = 'square'\nangle_deg = 0.0\nfile = 'x.npy'\nsampling = 'area'\n",
     )
     .unwrap();
     c.surfaces.insert("NAME".into(), surface);

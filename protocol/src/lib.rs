@@ -61,7 +61,8 @@ pub use wire::{
 /// load paths (`LoadHistory::shifts_m`), and results the cycle's amplitudes,
 /// energy ratio and slip regime: a worker of another build is refused
 /// cleanly instead of misreading them.
-pub const PROTOCOL_VERSION: u32 = 3;
+/// 4: a patterned surface in the payload carries its sampling (issue #34).
+pub const PROTOCOL_VERSION: u32 = 4;
 
 #[cfg(test)]
 mod tests;

@@ -28,6 +28,10 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     crate::progress::start_case();
     spec.validate()?;
     let (res, kernel_seconds) = cache.resident(spec)?;
+    // Every case sets its own cut cells (none on flat surfaces): the
+    // resident operator outlives the case.
+    res.operator
+        .set_cover(spec.surface.cover(&spec.grid).as_deref());
     let started = std::time::Instant::now();
     let n = spec.grid.n;
     let h0 = spec.initial_gap();

@@ -32,30 +32,38 @@ pub fn hull_area(grid: &Grid, mask: &[bool]) -> f64 {
 /// inner neighbour give `level²`, which is linear in the distance near such
 /// an edge; its zero, extrapolated outward, is a boundary point. The point is
 /// kept between the outermost cell's centre and the next (outside) centre,
-/// and within the cell's own outer face where the terrain falls away beyond
-/// it (`heights` lower in the outside cell: an island's edge, which the
-/// discretised island does not pass). Where the level does not fall outward
-/// (the pressure rising towards an island's edge, or a run one cell long)
-/// the point is the cell's outer face, as in [`hull_area`]. The hull of the
-/// row and column points is the area; unlike [`hull_area`], whose radius
-/// jumps by up to a cell as cells join, it moves continuously with the
-/// solution.
-pub fn subcell_hull_area(grid: &Grid, mask: &[bool], level: &[f64], heights: &[f64]) -> f64 {
+/// and within the terrain's own edge where it falls away beyond the cell
+/// (`heights` lower in the outside cell: an island's edge, which the contact
+/// cannot pass): the cell's outer face, or with a `cover` (the fraction of
+/// each cell on its upper part, [`crate::Surface::cover`]) the edge of that
+/// part, `cover − 1/2` of a pitch beyond the centre. Where the level does not
+/// fall outward (the pressure rising towards an island's edge, or a run one
+/// cell long) the point is that edge, or the cell's outer face on level
+/// ground, as in [`hull_area`]. The hull of the row and column points is the
+/// area; unlike [`hull_area`], whose radius jumps by up to a cell as cells
+/// join, it moves continuously with the solution.
+pub fn subcell_hull_area(
+    grid: &Grid,
+    mask: &[bool],
+    level: &[f64],
+    heights: &[f64],
+    cover: Option<&[f64]>,
+) -> f64 {
     let n = grid.n;
     // Fraction of a cell pitch beyond the edge cell's centre where the
     // boundary lies, from the edge value and its inner neighbour's.
     let reach = |edge: usize, inner: Option<usize>, outer: Option<usize>| -> f64 {
         let g0 = level[edge] * level[edge];
-        let limit = match outer {
-            Some(o) if heights[o] < heights[edge] => 0.5,
-            _ => 1.0,
+        let terrain = match outer {
+            Some(o) if heights[o] < heights[edge] => Some(cover.map_or(0.5, |c| c[edge] - 0.5)),
+            _ => None,
         };
         match inner {
             Some(i) if mask[i] && level[i] * level[i] > g0 => {
                 let g1 = level[i] * level[i];
-                (g0 / (g1 - g0)).min(limit)
+                (g0 / (g1 - g0)).min(terrain.unwrap_or(1.0))
             }
-            _ => 0.5,
+            _ => terrain.unwrap_or(0.5),
         }
     };
     // The first and last cell of the zone on one grid line (cell k of the
@@ -83,6 +91,23 @@ pub fn subcell_hull_area(grid: &Grid, mask: &[bool], level: &[f64], heights: &[f
         }
     }
     polygon_area(&convex_hull(pts))
+}
+
+/// Area (m²) of the cells in `mask`, each `da` times its `cover` (the
+/// fraction on its upper part, [`crate::Surface::cover`]) when there is one.
+pub fn covered_area(mask: &[bool], cover: Option<&[f64]>, da: f64) -> f64 {
+    match cover {
+        None => mask.iter().filter(|&&b| b).count() as f64 * da,
+        Some(c) => {
+            let sum: f64 = mask
+                .iter()
+                .zip(c)
+                .filter(|(&m, _)| m)
+                .map(|(_, &c)| c)
+                .sum();
+            sum * da
+        }
+    }
 }
 
 /// Radius of the circle with the given area.
@@ -183,7 +208,7 @@ mod tests {
                     .collect();
                 let mask: Vec<bool> = level.iter().map(|&v| v > 0.0).collect();
                 let flat = vec![0.0; grid.len()];
-                let sub = equivalent_radius(subcell_hull_area(&grid, &mask, &level, &flat));
+                let sub = equivalent_radius(subcell_hull_area(&grid, &mask, &level, &flat, None));
                 let cells = equivalent_radius(hull_area(&grid, &mask));
                 ((sub / a - 1.0).abs(), (cells / a - 1.0).abs())
             })

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::error::SolverError;
-use crate::geometry::{equivalent_radius, subcell_hull_area};
+use crate::geometry::{covered_area, equivalent_radius, subcell_hull_area};
 use crate::kernels::Resident;
 use crate::normal::{NormalProblem, NormalSolution};
 use crate::operator::{X, Y, Z};
@@ -175,11 +175,14 @@ pub(crate) fn solve_history(
     let (mut delta_t_max, mut last_increment) = (0.0_f64, 0.0_f64);
     let mut normal_iterations = last.normal_iterations;
     let (mut tangential_iterations, mut coupling_iterations) = (0, 0);
-    // The surface's heights (for the stick radius of every row), once.
+    // The surface's heights and cover (for the areas and stick radius of
+    // every row), once.
     let heights = spec.surface.heights(&grid);
+    let cover = res.operator.cover().map(<[f64]>::to_vec);
+    let terrain = (&heights[..], cover.as_deref());
     let mut rows = vec![row(
         spec,
-        &heights,
+        terrain,
         &last,
         &StepSums {
             step: 0,
@@ -312,7 +315,7 @@ pub(crate) fn solve_history(
             coupling_iterations += state.coupling_iterations;
             let r = row(
                 spec,
-                &heights,
+                terrain,
                 &state,
                 &StepSums {
                     step: step_no,
@@ -357,7 +360,13 @@ struct StepSums {
 }
 
 /// The table row of a solved increment.
-fn row(spec: &CaseSpec, heights: &[f64], state: &ContactState, sums: &StepSums) -> HistoryStep {
+/// `terrain`: the surface's heights and cover ([`crate::Surface::cover`]).
+fn row(
+    spec: &CaseSpec,
+    (heights, cover): (&[f64], Option<&[f64]>),
+    state: &ContactState,
+    sums: &StepSums,
+) -> HistoryStep {
     let grid = spec.grid;
     let (len, da) = (grid.len(), grid.cell_area());
     let p = &state.p;
@@ -365,12 +374,12 @@ fn row(spec: &CaseSpec, heights: &[f64], state: &ContactState, sums: &StepSums) 
     let mu = spec.load.friction;
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
     let stick: Vec<bool> = (0..len).map(|i| contact[i] && tan.stick[i]).collect();
-    let count = |v: &[bool]| v.iter().filter(|&&b| b).count() as f64 * da;
+    let count = |v: &[bool]| covered_area(v, cover, da);
     let reserve: Vec<f64> = (0..len)
         .map(|i| (mu * p[i] - tan.qx[i].hypot(tan.qy[i])).max(0.0))
         .collect();
     let stick_radius = if stick.iter().any(|&b| b) {
-        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights))
+        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights, cover))
     } else {
         0.0
     };

@@ -41,7 +41,7 @@
 //! Each module imports only from its own layer or those before it in this
 //! list, never in a circle; a type two layers need lives in the lower one:
 //!
-//! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`
+//! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`, `cover`
 //! 2. Green's functions: `influence`, `aniso`
 //! 3. description of a case: `material`, `surface`, `presets`, `spec`
 //! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables)
@@ -60,6 +60,8 @@ pub mod aniso;
 mod case;
 pub mod coarse_slip;
 mod coupling;
+#[doc(hidden)]
+pub mod cover;
 mod error;
 #[doc(hidden)]
 pub mod fft2;
@@ -107,4 +109,4 @@ pub use results::{
     K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
 pub use spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
-pub use surface::{Island, LatticeKind, Surface};
+pub use surface::{Island, LatticeKind, Sampling, Surface, MIN_COVER};

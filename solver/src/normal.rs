@@ -64,13 +64,23 @@ impl ZzApply for Fine<'_> {
     }
     fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
         let (grid, threads) = (self.op.grid(), self.op.threads());
-        self.precond
-            .get_or_insert_with(|| {
-                let mut pre = FourierPrecond::new(grid);
-                pre.set_threads(threads);
-                pre
-            })
-            .apply(g, active, z);
+        let pre = self.precond.get_or_insert_with(|| {
+            let mut pre = FourierPrecond::new(grid);
+            pre.set_threads(threads);
+            pre
+        });
+        if self.op.cover().is_none() {
+            pre.apply(g, active, z);
+            return;
+        }
+        // Cut cells: their own compliance is larger than the convolution's
+        // by `factor`; a symmetric Jacobi scaling around the Fourier inverse
+        // keeps them from slowing the iteration (quick sweep, circle-A at
+        // 128² of 60 µm: 169 iterations without it).
+        let mut scaled = g.to_vec();
+        self.op.scale_cut(&mut scaled);
+        pre.apply(&scaled, active, z);
+        self.op.scale_cut(z);
     }
 }
 

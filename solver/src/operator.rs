@@ -223,6 +223,59 @@ pub struct Operator {
     column_values: Vec<f64>,
     tangential_bound: f64,
     tangential_self: f64,
+    /// `K_ii(0, 0)` for i = x, y, z: a whole cell's own compliance.
+    self_compliance: [f64; 3],
+    /// The cells an edge cuts, if the case's surface has any.
+    cut: Option<CutCells>,
+}
+
+/// How much more compliant under its own load a cell is when only the
+/// fraction `cover` of it carries the load: `(1 + β (1 − cover)) / cover`
+/// with β = [`CUT_CELL_BETA`]. At β = 0 the covered part's pressure
+/// (`t / cover`) meets a whole cell's compliance; β makes a cut cell's
+/// stiffness move with its cover so that a straight-edged punch's stiffness
+/// moves linearly, not in a wave, as its edge crosses a cell (the
+/// consistency condition; measured in `docs/physics-choices.md`).
+pub fn cut_self_factor(cover: f64) -> f64 {
+    (1.0 + CUT_CELL_BETA * (1.0 - cover)) / cover
+}
+
+/// β of [`cut_self_factor`]: the factor that keeps a straight punch edge's
+/// stiffness linear in its position within a cell, measured at 3 to 24 cells
+/// per half-width (`cover · factor − 1 = β (1 − cover)` with β from 0.30 to
+/// 0.45, rising slowly with the resolution); 0.4 is the middle of that range.
+pub const CUT_CELL_BETA: f64 = 0.4;
+
+/// The cells of a grid that a pattern's edge cuts ([`crate::Surface::cover`]):
+/// each carries its cell-mean traction on the covered part only, and is more
+/// compliant under its own load by [`cut_self_factor`]. The operator adds
+/// `K_ii(0, 0) (factor − 1) t_i` to each cut cell's displacement.
+#[derive(Clone, Debug)]
+struct CutCells {
+    /// The cover of every cell (1 where whole), row-major.
+    cover: Vec<f64>,
+    /// The cut cells and their extra factor `cover^(-1/2) − 1`.
+    extra: Vec<(usize, f64)>,
+}
+
+impl CutCells {
+    fn new(cover: &[f64]) -> Self {
+        let extra = cover
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c < 1.0)
+            .map(|(i, &c)| (i, cut_self_factor(c) - 1.0))
+            .collect();
+        CutCells {
+            cover: cover.to_vec(),
+            extra,
+        }
+    }
+
+    /// The largest extra factor (0 without cut cells).
+    fn largest(&self) -> f64 {
+        self.extra.iter().fold(0.0, |m, &(_, e)| m.max(e))
+    }
 }
 
 /// Maximum over frequencies of the largest eigenvalue of the Hermitian
@@ -251,6 +304,17 @@ fn tangential_self(s: &Spectra, m: usize) -> f64 {
         sum += weight * col;
     }
     0.5 * sum / (m as f64 * m as f64)
+}
+
+/// `K_ii(0, 0)` of one diagonal component, the mean of its spectrum over the
+/// full `m x m` grid as in [`tangential_self`] (0 for a component not held).
+fn self_compliance(d: &[f64], m: usize) -> f64 {
+    let mut sum = 0.0;
+    for (kx, col) in d.chunks(m).enumerate() {
+        let weight = if kx == 0 || 2 * kx == m { 1.0 } else { 2.0 };
+        sum += weight * col.iter().sum::<f64>();
+    }
+    sum / (m as f64 * m as f64)
 }
 
 /// The kernel values of row `iy` of the `2N x 2N` wrap-around grid
@@ -407,11 +471,17 @@ impl Operator {
     fn with_fft(grid: Grid, fft: Fft2, mut spectra: Spectra) -> Self {
         let tangential_bound = tangential_symbol_max(&spectra);
         let tangential_self = tangential_self(&spectra, fft.padded_len());
+        let self_compliance = spectra
+            .diag
+            .each_ref()
+            .map(|d| self_compliance(d, fft.padded_len()));
         split_order(&fft, &mut spectra, true);
         Operator {
             grid,
             tangential_bound,
             tangential_self,
+            self_compliance,
+            cut: None,
             spectra,
             work: std::array::from_fn(|_| vec![Complex64::default(); fft.compact_len()]),
             column_values: vec![0.0; fft.padded_len() / 2 + 1],
@@ -556,6 +626,51 @@ impl Operator {
         r
     }
 
+    /// Sets the cover of the cells for the solves that follow (the case's
+    /// [`crate::Surface::cover`]): cut cells (cover < 1) get their own
+    /// compliance times `cover^(-1/2)` in every application, energy product
+    /// and tangential bound. `None` (whole cells) restores the bare
+    /// convolution, to the bit.
+    pub fn set_cover(&mut self, cover: Option<&[f64]>) {
+        if let Some(c) = cover {
+            assert_eq!(c.len(), self.grid.len(), "one cover per cell");
+        }
+        self.cut = cover.map(CutCells::new).filter(|c| !c.extra.is_empty());
+    }
+
+    /// The cover set by [`Operator::set_cover`], if any cell is cut.
+    pub fn cover(&self) -> Option<&[f64]> {
+        self.cut.as_ref().map(|c| c.cover.as_slice())
+    }
+
+    /// Multiplies the cut cells' entries of `v` by `factor^(-1/2)` (their
+    /// own compliance relative to a whole cell's, [`cut_self_factor`]): the
+    /// symmetric Jacobi scaling that a preconditioner of the bare
+    /// convolution needs around it to see the cut cells' larger diagonal.
+    /// Nothing without cut cells.
+    pub fn scale_cut(&self, v: &mut [f64]) {
+        if let Some(cut) = &self.cut {
+            for &(c, e) in &cut.extra {
+                v[c] /= (1.0 + e).sqrt();
+            }
+        }
+    }
+
+    /// Adds the cut cells' extra own compliance to the destinations whose
+    /// component has a source of the same component.
+    fn add_cut(&self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])]) {
+        let Some(cut) = &self.cut else { return };
+        for (i, u) in dst.iter_mut() {
+            let Some((_, t)) = src.iter().find(|(j, _)| j == i) else {
+                continue;
+            };
+            let k = self.self_compliance[*i];
+            for &(c, e) in &cut.extra {
+                u[c] += k * e * t[c];
+            }
+        }
+    }
+
     /// The grid this operator was built for.
     pub fn grid(&self) -> Grid {
         self.grid
@@ -633,6 +748,7 @@ impl Operator {
         for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
             self.fft.inverse_rows_cropped(w, u, add);
         }
+        self.add_cut(src, dst);
     }
 
     /// The elastic energy product `⟨t, K t⟩ = Σ_cells t · (K t)` of a shear
@@ -676,13 +792,26 @@ impl Operator {
         for v in &self.column_values {
             sum += v;
         }
-        sum / (m as f64 * m as f64)
+        let mut energy = sum / (m as f64 * m as f64);
+        if let Some(cut) = &self.cut {
+            let [kx, ky, _] = self.self_compliance;
+            for &(c, e) in &cut.extra {
+                energy += e * (kx * tx[c] * tx[c] + ky * ty[c] * ty[c]);
+            }
+        }
+        energy
     }
 
     /// Upper bound of the largest eigenvalue of the tangential block (m/Pa),
     /// computed once at construction (the tangential solver's step is its inverse).
     pub fn tangential_bound(&self) -> f64 {
-        self.tangential_bound
+        match &self.cut {
+            None => self.tangential_bound,
+            Some(cut) => {
+                let [kx, ky, _] = self.self_compliance;
+                self.tangential_bound + cut.largest() * kx.max(ky)
+            }
+        }
     }
 
     /// The mean of `K_xx` and `K_yy` at zero offset (m/Pa): a cell's own

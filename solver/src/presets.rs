@@ -76,6 +76,7 @@ pub fn surfaces() -> Vec<(&'static str, Surface)> {
         height: 30.0 * UM,
         offset: [0.0, 0.0],
         lattice: crate::surface::LatticeKind::Square,
+        sampling: crate::surface::Sampling::Area,
     };
     let circle = Island::Circle {
         diameter: 400.0 * UM,

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::ContactState;
 use crate::error::SolverError;
-use crate::geometry::{equivalent_radius, hull_area, subcell_hull_area};
+use crate::geometry::{covered_area, equivalent_radius, hull_area, subcell_hull_area};
 use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
@@ -271,8 +271,12 @@ pub(crate) fn reduce(
 
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
     let stick_in_contact: Vec<bool> = (0..len).map(|i| contact[i] && stick[i]).collect();
-    let contact_area = contact.iter().filter(|&&b| b).count() as f64 * da;
-    let stick_area = stick_in_contact.iter().filter(|&&b| b).count() as f64 * da;
+    // A cut cell contributes its covered part (`cover`, set on the operator
+    // for this case by the driver).
+    let cover = op.cover().map(<[f64]>::to_vec);
+    let cover = cover.as_deref();
+    let contact_area = covered_area(&contact, cover, da);
+    let stick_area = covered_area(&stick_in_contact, cover, da);
     // The paper's radii (whole cells) decide what the grid resolves, as
     // before the sub-cell radii existed; the two differ by less than a cell.
     let a = equivalent_radius(hull_area(&grid, &contact));
@@ -324,7 +328,7 @@ pub(crate) fn reduce(
     // Sub-cell radii: p falls to zero like the root of the distance at a
     // Hertzian edge, and μp − |q| does at a Mindlin stick edge.
     let friction = spec.load.friction;
-    let a_sub = equivalent_radius(subcell_hull_area(&grid, &contact, &p, &heights));
+    let a_sub = equivalent_radius(subcell_hull_area(&grid, &contact, &p, &heights, cover));
     let c_sub = if has_stick_set {
         let reserve: Vec<f64> = (0..len)
             .map(|i| (friction * p[i] - qx[i].hypot(qy[i])).max(0.0))
@@ -334,6 +338,7 @@ pub(crate) fn reduce(
             &stick_in_contact,
             &reserve,
             &heights,
+            cover,
         ))
     } else {
         a_sub

@@ -3,6 +3,7 @@
 //! the solver grid. Produces the height field on the grid; the indenter profile
 //! and the initial separation `h0` are assembled in `case`.
 
+use crate::cover::{disc_in_rect, rect_in_rect, strip_in_rect, Rect};
 use crate::error::SolverError;
 use crate::grid::Grid;
 use serde::{Deserialize, Serialize};
@@ -34,6 +35,36 @@ pub enum LatticeKind {
     Hexagonal,
 }
 
+/// How a patterned surface is put on the grid.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Sampling {
+    /// Each cell carries its upper part only, with that part's exact area
+    /// fraction (its cover); a cell cut by an edge is a smaller, more
+    /// compliant cell (see [`Surface::cover`]). The default.
+    #[default]
+    Area,
+    /// Whole cells, on the raised part when their centre is (the paper's).
+    Centre,
+}
+
+impl Sampling {
+    /// The name used in configs and outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampling::Area => "area",
+            Sampling::Centre => "centre",
+        }
+    }
+}
+
+/// Covers below this fraction of a cell count as uncovered: such a sliver
+/// would carry under 1.5 % of a whole cell's load (its compliance grows as
+/// `1/cover`, [`crate::operator::cut_self_factor`]), and keeping it would
+/// raise the tangential operator's largest eigenvalue, and so slow its
+/// solver, for nothing.
+pub const MIN_COVER: f64 = 0.02;
+
 /// A substrate surface.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Surface {
@@ -52,6 +83,9 @@ pub enum Surface {
         /// Square or hexagonal arrangement.
         #[serde(default)]
         lattice: LatticeKind,
+        /// How the islands' edges are put on the grid.
+        #[serde(default)]
+        sampling: Sampling,
     },
     /// Parallel raised stripes (ridges) of a given width.
     Stripes {
@@ -65,6 +99,9 @@ pub enum Surface {
         angle_deg: f64,
         /// Offset of one ridge centre line from the apex, across the ridges, m.
         offset: f64,
+        /// How the ridges' edges are put on the grid.
+        #[serde(default)]
+        sampling: Sampling,
     },
     /// Heights on the solver grid (m), row-major `[iy][ix]`, `n x n`.
     Heightmap {
@@ -134,6 +171,7 @@ impl Surface {
                 height,
                 angle_deg,
                 offset,
+                ..
             } => {
                 positive("pitch", *pitch, "the stripe pitch")?;
                 positive("width", *width, "the stripe width")?;
@@ -176,7 +214,11 @@ impl Surface {
         }
     }
 
-    /// Height of the surface above its base at each cell centre (m), row-major.
+    /// Height of each cell above the base (m), row-major: for a pattern
+    /// sampled by [`Sampling::Centre`], the level at the cell's centre; by
+    /// [`Sampling::Area`], the level of the cell's upper part (the raised
+    /// level wherever at least [`MIN_COVER`] of the cell is raised). Height
+    /// maps give one height per cell as they are.
     pub fn heights(&self, grid: &Grid) -> Vec<f64> {
         let n = grid.n;
         let mut h = vec![0.0; grid.len()];
@@ -189,6 +231,7 @@ impl Surface {
                 height,
                 angle_deg,
                 offset,
+                sampling: Sampling::Centre,
             } => {
                 let (s, c) = angle_deg.to_radians().sin_cos();
                 for iy in 0..n {
@@ -208,6 +251,7 @@ impl Surface {
                 height,
                 offset,
                 lattice,
+                sampling: Sampling::Centre,
             } => {
                 for iy in 0..n {
                     for ix in 0..n {
@@ -229,8 +273,159 @@ impl Surface {
                     }
                 }
             }
+            Surface::Lattice { height, .. } | Surface::Stripes { height, .. } => {
+                let raised = self.raised_fraction(grid);
+                for (h, &f) in h.iter_mut().zip(&raised) {
+                    let upper = if *height > 0.0 { f } else { 1.0 - f };
+                    *h = if upper >= MIN_COVER {
+                        height.max(0.0)
+                    } else {
+                        height.min(0.0)
+                    };
+                }
+            }
         }
         h
+    }
+
+    /// The fraction of each cell's area at the level [`Surface::heights`]
+    /// gives it, row-major: below 1 on the cells that an edge cuts (their
+    /// upper part), 1 elsewhere. `None` when every cell is whole (flat
+    /// surfaces, height maps, patterns sampled by [`Sampling::Centre`]).
+    ///
+    /// A cut cell carries its load on that part only: the solver takes the
+    /// cell-mean tractions as unknowns, so that forces are sums over cells as
+    /// everywhere, counts the cell's area times its cover, and makes the cell
+    /// more compliant under its own load
+    /// ([`crate::operator::cut_self_factor`], `docs/physics-choices.md`).
+    pub fn cover(&self, grid: &Grid) -> Option<Vec<f64>> {
+        let height = match self {
+            Surface::Lattice {
+                height,
+                sampling: Sampling::Area,
+                ..
+            }
+            | Surface::Stripes {
+                height,
+                sampling: Sampling::Area,
+                ..
+            } => *height,
+            _ => return None,
+        };
+        let mut cut = false;
+        let cover: Vec<f64> = self
+            .raised_fraction(grid)
+            .into_iter()
+            .map(|f| {
+                let upper = if height > 0.0 { f } else { 1.0 - f };
+                if (MIN_COVER..1.0).contains(&upper) {
+                    cut = true;
+                    upper
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        cut.then_some(cover)
+    }
+
+    /// The sampling of a patterned surface (`None` for flat surfaces and
+    /// height maps, which have no edges to sample).
+    pub fn sampling(&self) -> Option<Sampling> {
+        match self {
+            Surface::Lattice { sampling, .. } | Surface::Stripes { sampling, .. } => {
+                Some(*sampling)
+            }
+            Surface::Flat | Surface::Heightmap { .. } => None,
+        }
+    }
+
+    /// Exact fraction of each cell's area on the islands or ridges
+    /// (closed-form areas of [`crate::cover`]), row-major; zeros for flat
+    /// surfaces and height maps.
+    pub fn raised_fraction(&self, grid: &Grid) -> Vec<f64> {
+        let n = grid.n;
+        let mut f = vec![0.0; grid.len()];
+        let (dx, dy) = (grid.dx, grid.dy);
+        let half_diagonal = 0.5 * dx.hypot(dy);
+        match self {
+            Surface::Flat | Surface::Heightmap { .. } => {}
+            Surface::Stripes {
+                width,
+                pitch,
+                angle_deg,
+                offset,
+                ..
+            } => {
+                let (s, c) = angle_deg.to_radians().sin_cos();
+                let (nx, ny) = (-s, c);
+                // Half the extent of a cell across the ridges.
+                let spread = 0.5 * (dx * s.abs() + dy * c.abs());
+                for iy in 0..n {
+                    for ix in 0..n {
+                        let (x, y) = (grid.x(ix), grid.y(iy));
+                        let d = nx * x + ny * y - offset;
+                        let u = d - pitch * (d / pitch).round();
+                        let cell = &mut f[iy * n + ix];
+                        if u.abs() + spread <= 0.5 * width {
+                            *cell = 1.0;
+                        } else if u.abs() - spread < 0.5 * width
+                            || pitch - u.abs() - spread < 0.5 * width
+                        {
+                            let rect = Rect::cell(x, y, dx, dy);
+                            let k0 = ((d - spread - 0.5 * width) / pitch).ceil() as i64;
+                            let k1 = ((d + spread + 0.5 * width) / pitch).floor() as i64;
+                            let area: f64 = (k0..=k1)
+                                .map(|k| {
+                                    let line = offset + k as f64 * pitch;
+                                    strip_in_rect(nx, ny, line, *width, &rect)
+                                })
+                                .sum();
+                            *cell = (area / rect.area()).min(1.0);
+                        }
+                    }
+                }
+            }
+            Surface::Lattice {
+                island,
+                pitch,
+                offset,
+                lattice,
+                ..
+            } => {
+                let reach = match island {
+                    Island::Circle { diameter } => 0.5 * diameter,
+                    Island::Square { side } => side * std::f64::consts::FRAC_1_SQRT_2,
+                };
+                for iy in 0..n {
+                    for ix in 0..n {
+                        let (x, y) = (grid.x(ix), grid.y(iy));
+                        let (u, v) =
+                            nearest_centre_offset(*lattice, *pitch, x - offset[0], y - offset[1]);
+                        // Whole cells (inside or outside the nearest island)
+                        // first; only cells near an edge are integrated.
+                        let inside = match island {
+                            Island::Circle { diameter } => {
+                                u.hypot(v) + half_diagonal <= 0.5 * diameter
+                            }
+                            Island::Square { side } => {
+                                u.abs() + 0.5 * dx <= 0.5 * side && v.abs() + 0.5 * dy <= 0.5 * side
+                            }
+                        };
+                        let cell = &mut f[iy * n + ix];
+                        if inside {
+                            *cell = 1.0;
+                        } else if u.hypot(v) - half_diagonal < reach {
+                            let rect = Rect::cell(x, y, dx, dy);
+                            let area =
+                                lattice_area_in(*island, *lattice, *pitch, *offset, reach, &rect);
+                            *cell = (area / rect.area()).min(1.0);
+                        }
+                    }
+                }
+            }
+        }
+        f
     }
 
     /// Area fraction of the surface covered by islands or ridges (0 for flat and height maps).
@@ -288,6 +483,39 @@ fn nearest_centre_offset(kind: LatticeKind, pitch: f64, x: f64, y: f64) -> (f64,
     }
 }
 
+/// Area of the islands of a lattice inside `rect`: every site whose island
+/// (circumradius `reach`) can reach the rectangle, summed (islands never
+/// overlap, [`Surface::validate`]).
+fn lattice_area_in(
+    island: Island,
+    lattice: LatticeKind,
+    pitch: f64,
+    offset: [f64; 2],
+    reach: f64,
+    rect: &Rect,
+) -> f64 {
+    let (x0, x1) = (rect.x0 - reach - offset[0], rect.x1 + reach - offset[0]);
+    let (y0, y1) = (rect.y0 - reach - offset[1], rect.y1 + reach - offset[1]);
+    let (row, shear) = match lattice {
+        LatticeKind::Square => (pitch, 0.0),
+        LatticeKind::Hexagonal => (pitch * 3f64.sqrt() / 2.0, 0.5 * pitch),
+    };
+    let mut area = 0.0;
+    for j in (y0 / row).ceil() as i64..=(y1 / row).floor() as i64 {
+        let cy = j as f64 * row;
+        let start = shear * j as f64;
+        for i in ((x0 - start) / pitch).ceil() as i64..=((x1 - start) / pitch).floor() as i64 {
+            let cx = start + i as f64 * pitch;
+            let (sx, sy) = (offset[0] + cx, offset[1] + cy);
+            area += match island {
+                Island::Circle { diameter } => disc_in_rect(sx, sy, 0.5 * diameter, rect),
+                Island::Square { side } => rect_in_rect(&Rect::square(sx, sy, side), rect),
+            };
+        }
+    }
+    area
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -306,6 +534,7 @@ mod tests {
                 height: 1e-6,
                 offset: [3e-6, -7e-6],
                 lattice: LatticeKind::Square,
+                sampling: Sampling::Centre,
             },
             Surface::Lattice {
                 island: Island::Square { side: 20e-6 },
@@ -313,6 +542,7 @@ mod tests {
                 height: -1e-6,
                 offset: [0.0, 0.0],
                 lattice: LatticeKind::Square,
+                sampling: Sampling::Centre,
             },
             Surface::Lattice {
                 island: Island::Circle { diameter: 30e-6 },
@@ -320,6 +550,7 @@ mod tests {
                 height: 1e-6,
                 offset: [0.0, 0.0],
                 lattice: LatticeKind::Hexagonal,
+                sampling: Sampling::Centre,
             },
             Surface::Stripes {
                 width: 10e-6,
@@ -327,6 +558,7 @@ mod tests {
                 height: 1e-6,
                 angle_deg: 30.0,
                 offset: 0.0,
+                sampling: Sampling::Centre,
             },
         ];
         for s in &surfaces {
@@ -339,6 +571,89 @@ mod tests {
                 s.density()
             );
         }
+    }
+
+    /// The exact cover sums to the pattern's density: to round-off over a
+    /// whole number of square-lattice periods, within the part-period
+    /// border otherwise; the centre sampling of the same grid does not.
+    #[test]
+    fn area_sampling_covers_exactly_the_patterns_area() {
+        let grid = Grid {
+            n: 400,
+            dx: 1.3e-6,
+            dy: 1.3e-6,
+        };
+        // 400 cells of 1.3 µm = 520 µm: 8 periods of 65 µm.
+        let circle = Surface::Lattice {
+            island: Island::Circle { diameter: 41e-6 },
+            pitch: 65e-6,
+            height: 1e-6,
+            offset: [3.1e-6, -7.7e-6],
+            lattice: LatticeKind::Square,
+            sampling: Sampling::Area,
+        };
+        let dimples = Surface::Lattice {
+            island: Island::Square { side: 27.3e-6 },
+            pitch: 65e-6,
+            height: -1e-6,
+            offset: [0.4e-6, 0.0],
+            lattice: LatticeKind::Square,
+            sampling: Sampling::Area,
+        };
+        for s in [&circle, &dimples] {
+            let f = s.raised_fraction(&grid);
+            let mean = f.iter().sum::<f64>() / grid.len() as f64;
+            assert!((mean / s.density() - 1.0).abs() < 1e-12, "{s:?}: {mean}");
+        }
+        let hex = Surface::Lattice {
+            island: Island::Circle { diameter: 30e-6 },
+            pitch: 50e-6,
+            height: 1e-6,
+            offset: [0.0, 0.0],
+            lattice: LatticeKind::Hexagonal,
+            sampling: Sampling::Area,
+        };
+        let ridges = Surface::Stripes {
+            width: 10e-6,
+            pitch: 40e-6,
+            height: 1e-6,
+            angle_deg: 30.0,
+            offset: 2.0e-6,
+            sampling: Sampling::Area,
+        };
+        for s in [&hex, &ridges] {
+            let f = s.raised_fraction(&grid);
+            let mean = f.iter().sum::<f64>() / grid.len() as f64;
+            assert!((mean / s.density() - 1.0).abs() < 0.02, "{s:?}: {mean}");
+        }
+        // Heights and cover agree: a cut cell is raised (islands) or at the
+        // base (dimples) and its cover is its upper part's fraction.
+        let (h, c) = (circle.heights(&grid), circle.cover(&grid).unwrap());
+        let f = circle.raised_fraction(&grid);
+        for i in 0..grid.len() {
+            if f[i] >= MIN_COVER {
+                assert_eq!(h[i], 1e-6);
+                assert!(f[i] == 1.0 || c[i] == f[i]);
+            } else {
+                assert_eq!((h[i], c[i]), (0.0, 1.0));
+            }
+        }
+        let (h, c) = (dimples.heights(&grid), dimples.cover(&grid).unwrap());
+        let f = dimples.raised_fraction(&grid);
+        for i in 0..grid.len() {
+            if 1.0 - f[i] >= MIN_COVER {
+                assert_eq!(h[i], 0.0);
+                assert!(f[i] == 0.0 || (c[i] - (1.0 - f[i])).abs() < 1e-15);
+            } else {
+                assert_eq!((h[i], c[i]), (-1e-6, 1.0));
+            }
+        }
+        // Centre sampling has no cut cells.
+        let mut centre = circle.clone();
+        if let Surface::Lattice { sampling, .. } = &mut centre {
+            *sampling = Sampling::Centre;
+        }
+        assert!(centre.cover(&grid).is_none());
     }
 
     #[test]
@@ -369,6 +684,7 @@ mod tests {
                     height: 1e-6,
                     offset: [0.0, 0.0],
                     lattice: LatticeKind::Hexagonal,
+                    sampling: Sampling::Area,
                 },
                 "side",
             ),
@@ -379,6 +695,7 @@ mod tests {
                     height: 1e-6,
                     angle_deg: 0.0,
                     offset: 0.0,
+                    sampling: Sampling::Area,
                 },
                 "width",
             ),

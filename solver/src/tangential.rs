@@ -213,7 +213,9 @@ pub(crate) fn solve_tangential_taking(
         extra: extra.as_ref().map(|(x, y)| (&x[..], &y[..])),
         ..*prob
     };
+    let cover = op.cover().map(|c| win.gather(c));
     let (wop, levels) = windows.operator_and_levels(op, win.n);
+    wop.set_cover(cover.as_deref());
     let sol = solve_nested_taking(wop, levels, &sub, q_init)?;
     Ok(TangentialSolution {
         qx: win.scatter(&sol.qx, 0.0),

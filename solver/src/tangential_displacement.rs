@@ -73,7 +73,9 @@ pub fn solve_displacement(
         },
         ..*prob
     };
+    let cover = op.cover().map(|c| win.gather(c));
     let wop = windows.operator(op, win.n);
+    wop.set_cover(cover.as_deref());
     let sol = solve_displacement_on_grid(wop, &sub)?;
     Ok(TangentialSolution {
         qx: win.scatter(&sol.qx, 0.0),

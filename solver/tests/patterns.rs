@@ -3,7 +3,7 @@
 //! symmetries μa must have.
 
 use solver::{calibrate_k_e, solve_case, CaseOutput, CaseSpec, Grid, KernelCache, Load, Numerics};
-use solver::{Island, LatticeKind, Surface};
+use solver::{Island, LatticeKind, Sampling, Surface};
 
 /// Paper Table 1(c) conditions on `n` cells of `spacing_um`.
 fn table_1c(material: &str, surface: &str, n: usize, spacing_um: f64, angle: f64) -> CaseSpec {
@@ -46,10 +46,21 @@ fn a_pattern_of_vanishing_height_gives_the_flat_result() {
     let mut cache = KernelCache::new();
     let flat = solve(&table_1c("Cu", "flat", 128, 40.0, 0.0), &mut cache);
     let mut spec = table_1c("Cu", "circle-B", 128, 40.0, 0.0);
-    if let Surface::Lattice { height, .. } = &mut spec.surface {
+    if let Surface::Lattice {
+        height, sampling, ..
+    } = &mut spec.surface
+    {
         *height = 1e-13;
+        // Whole cells: the area sampling keeps a cut cell's lower part clear
+        // of the sphere, which a vanishing height does not; it touches the
+        // base and says so (below).
+        *sampling = Sampling::Centre;
     }
     let low = solve(&spec, &mut cache);
+    if let Surface::Lattice { sampling, .. } = &mut spec.surface {
+        *sampling = Sampling::Area;
+    }
+    assert!(solve(&spec, &mut cache).scalars.base_contact);
     let dp = flat
         .fields
         .p
@@ -69,8 +80,8 @@ fn a_pattern_of_vanishing_height_gives_the_flat_result() {
     assert!((a.mu_a.unwrap() / b.mu_a.unwrap() - 1.0).abs() < 1e-6);
 }
 
-/// Cells on an island with a neighbour off the island.
-fn edge_cells(h: &[f64], n: usize) -> Vec<bool> {
+/// Cells on an island with a neighbour off the island, or cut by its edge.
+fn edge_cells(h: &[f64], cover: &[f64], n: usize) -> Vec<bool> {
     (0..n * n)
         .map(|i| {
             let (x, y) = (i % n, i / n);
@@ -79,7 +90,7 @@ fn edge_cells(h: &[f64], n: usize) -> Vec<bool> {
                 && y > 0
                 && x + 1 < n
                 && y + 1 < n
-                && [i - 1, i + 1, i - n, i + n].iter().any(|&j| h[j] <= 0.0)
+                && (cover[i] < 1.0 || [i - 1, i + 1, i - n, i + n].iter().any(|&j| h[j] <= 0.0))
         })
         .collect()
 }
@@ -94,11 +105,15 @@ fn table_1c_patterns_contact_island_tops_and_dense_patterns_lower_mu_a() {
         let s = &out.scalars;
         let n = spec.grid.n;
         let h = spec.surface.heights(&spec.grid);
-        // Where does the shear traction peak? On an island edge cell.
-        let imax = (0..n * n)
-            .max_by(|&i, &j| out.fields.qx[i].abs().total_cmp(&out.fields.qx[j].abs()))
-            .unwrap();
-        let on_edge = edge_cells(&h, n)[imax];
+        let cover = spec
+            .surface
+            .cover(&spec.grid)
+            .unwrap_or_else(|| vec![1.0; n * n]);
+        // Where does the shear traction on the covered part (a cut cell's
+        // mean over its cover) peak? On an island edge cell.
+        let q = |i: usize| out.fields.qx[i].abs() / cover[i];
+        let imax = (0..n * n).max_by(|&i, &j| q(i).total_cmp(&q(j))).unwrap();
+        let on_edge = edge_cells(&h, &cover, n)[imax];
         println!(
             "{surface:9} μa = {:.4}  a = {:.3} mm  c = {:.3} mm  stick area = {:.3} mm²  p_max/p_H = {:.2}  q_max/p_H = {:.2}  base touched: {}  qx peak on an edge cell: {on_edge}",
             s.mu_a.unwrap(),
@@ -156,6 +171,7 @@ fn hexagonal_lattice_and_stripes_solve_with_equilibrium() {
         height: 30e-6,
         offset: [0.0, 0.0],
         lattice: LatticeKind::Hexagonal,
+        sampling: Sampling::Area,
     };
     let hex = solve(&spec, &mut cache).scalars;
     spec.surface = Surface::Stripes {
@@ -164,6 +180,7 @@ fn hexagonal_lattice_and_stripes_solve_with_equilibrium() {
         height: 30e-6,
         angle_deg: 90.0,
         offset: 0.0,
+        sampling: Sampling::Area,
     };
     let stripes = solve(&spec, &mut cache).scalars;
     println!(
@@ -225,6 +242,11 @@ fn an_unresolved_slip_zone_is_a_named_error_not_an_infinite_mu_a() {
     let mut spec = table_1c("Ni", "circle-A", 32, 200.0, 0.0);
     spec.load.tangential_ratio = 0.3;
     spec.numerics.coupling = false;
+    // Whole cells, as the paper samples them (with the cut cells' cover
+    // the outline slips even here).
+    if let Surface::Lattice { sampling, .. } = &mut spec.surface {
+        *sampling = Sampling::Centre;
+    }
     let err = solve_case(&spec, &mut KernelCache::new()).unwrap_err();
     assert!(
         matches!(err, solver::SolverError::SlipUnresolved { .. }),

@@ -6,7 +6,7 @@ use super::{within, Config};
 use crate::npy::read_grid_npy;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
-use solver::{Island, LatticeKind, Surface};
+use solver::{Island, LatticeKind, Sampling, Surface};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -14,8 +14,13 @@ use std::path::Path;
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceCfg {
-    /// `flat`, `circle`, `square`, `stripe` or `heightmap`.
-    pub shape: String,
+    /// `flat`, `circle`, `square`, `stripe` or `heightmap`; absent in a
+    /// table named after a preset, which then only sets `sampling`.
+    pub shape: Option<String>,
+    /// How a pattern's edges are put on the grid: `area` (default, each
+    /// cell's exact covered fraction) or `centre` (whole cells by their
+    /// centre, the paper's).
+    pub sampling: Option<String>,
     /// Circle diameter, µm.
     pub diameter_um: Option<f64>,
     /// Square side, µm.
@@ -92,15 +97,62 @@ pub fn heightmap_surface(n: usize, heights_um: &[f64]) -> Surface {
     }
 }
 
+/// The sampling named by `surfaces.NAME.sampling` (default `area`).
+fn sampling(name: &str, s: &SurfaceCfg) -> Result<Sampling> {
+    Ok(match s.sampling.as_deref() {
+        None | Some("area") => Sampling::Area,
+        Some("centre") | Some("center") => Sampling::Centre,
+        Some(other) => {
+            bail!("surfaces.{name}.sampling: unknown sampling `{other}` (area, centre)")
+        }
+    })
+}
+
+/// A preset named by a table without `shape`: the preset with the table's
+/// `sampling` (the only key such a table may set).
+fn preset_with_sampling(name: &str, s: &SurfaceCfg) -> Result<Surface> {
+    let mut surface = solver::presets::surface(name).ok_or_else(|| {
+        anyhow!("surfaces.{name}.shape: required (`{name}` is not a preset; shapes: flat, circle, square, stripe, heightmap)")
+    })?;
+    let others = [
+        s.diameter_um,
+        s.side_um,
+        s.width_um,
+        s.pitch_um,
+        s.height_um,
+        s.angle_deg,
+    ]
+    .iter()
+    .any(Option::is_some)
+        || s.lattice.is_some()
+        || s.file.is_some()
+        || s.offset_um != [0.0, 0.0];
+    if others {
+        bail!("surfaces.{name}: a table named after the preset `{name}` without `shape` may only set `sampling`; give `shape` (and all its dimensions) to define a new surface");
+    }
+    let chosen = sampling(name, s)?;
+    match &mut surface {
+        Surface::Lattice { sampling, .. } | Surface::Stripes { sampling, .. } => *sampling = chosen,
+        Surface::Flat | Surface::Heightmap { .. } => {}
+    }
+    Ok(surface)
+}
+
 fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Surface> {
+    let Some(shape) = s.shape.as_deref() else {
+        return preset_with_sampling(name, s);
+    };
     let need = |v: Option<f64>, k: &str| {
-        v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{}\"", s.shape))
+        v.ok_or_else(|| anyhow!("surfaces.{name}.{k}: required for shape = \"{shape}\""))
     };
     let um = 1e-6;
-    let surface = match s.shape.as_str() {
+    if matches!(shape, "flat" | "heightmap") && s.sampling.is_some() {
+        bail!("surfaces.{name}.sampling: only patterns (circle, square, stripe) have edges to sample; a {shape} surface has one height per cell");
+    }
+    let surface = match shape {
         "flat" => Surface::Flat,
         "circle" | "square" => {
-            let island = if s.shape == "circle" {
+            let island = if shape == "circle" {
                 Island::Circle {
                     diameter: need(s.diameter_um, "diameter_um")? * um,
                 }
@@ -120,6 +172,7 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
                 height: need(s.height_um, "height_um")? * um,
                 offset: [s.offset_um[0] * um, s.offset_um[1] * um],
                 lattice,
+                sampling: sampling(name, s)?,
             }
         }
         "stripe" => Surface::Stripes {
@@ -128,6 +181,7 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
             height: need(s.height_um, "height_um")? * um,
             angle_deg: s.angle_deg.unwrap_or(90.0),
             offset: s.offset_um[0] * um,
+            sampling: sampling(name, s)?,
         },
         "heightmap" => {
             let file = s

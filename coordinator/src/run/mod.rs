@@ -240,6 +240,17 @@ fn write_outputs(
     summary.convergence_levels = levels;
     summary.incomplete_points = incomplete;
     summary.curves = output::curve_summaries(&points);
+    summary.sampling = cases
+        .iter()
+        .map(|c| {
+            let how = c
+                .spec
+                .surface
+                .sampling()
+                .map_or("none", solver::Sampling::name);
+            (c.key.surface.to_string(), how)
+        })
+        .collect();
     // Cases with a load history: their table and loop beside their fields.
     for r in &rows {
         let Some(h) = r.scalars.as_ref().and_then(|s| s.history.as_ref()) else {

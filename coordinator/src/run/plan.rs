@@ -239,6 +239,7 @@ pub(crate) mod tests {
             height: 3e-5,
             offset: [0.0, 0.0],
             lattice: solver::LatticeKind::Square,
+            sampling: solver::Sampling::Area,
         };
         let p = Plan::new(vec![
             (key("A", "flat", 0.0), spec("A", 0.0)),

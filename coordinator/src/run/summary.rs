@@ -149,6 +149,10 @@ pub struct RunSummary {
     pub curves: BTreeMap<String, super::output::CurveSummary>,
     /// How K_E is obtained.
     pub k_e_definition: &'static str,
+    /// By surface name, how its edges were put on the grid: `area` (the
+    /// cut cells' exact cover) or `centre` (whole cells); `none` for flat
+    /// surfaces and height maps.
+    pub sampling: BTreeMap<String, &'static str>,
 }
 
 impl RunSummary {
