@@ -219,6 +219,60 @@ mod tests {
     }
 
     #[test]
+    fn sampling_is_area_by_default_centre_on_request_and_checked() {
+        use solver::Sampling;
+        let with = |extra: &str, surface: &str| {
+            format!("{BASE}\n{extra}").replace(
+                "surfaces = [\"flat\"]",
+                &format!("surfaces = [\"{surface}\"]"),
+            )
+        };
+        let c = Config::parse(&with("", "circle-A"), &[]).unwrap();
+        assert_eq!(
+            c.surface("circle-A").unwrap().sampling(),
+            Some(Sampling::Area)
+        );
+        // A preset's table without shape sets its sampling only.
+        let text = with("[surfaces.circle-A]\nsampling = \"centre\"\n", "circle-A");
+        let c = Config::parse(&text, &[]).unwrap();
+        let mut preset = solver::presets::surface("circle-A").unwrap();
+        if let Surface::Lattice { sampling, .. } = &mut preset {
+            *sampling = Sampling::Centre;
+        }
+        assert_eq!(c.surface("circle-A").unwrap(), preset);
+        let bad = with("[surfaces.circle-A]\nsampling = \"corner\"\n", "circle-A");
+        assert!(
+            err(&bad, &[]).contains("surfaces.circle-A.sampling: unknown sampling `corner`"),
+            "{}",
+            err(&bad, &[])
+        );
+        let more = with(
+            "[surfaces.circle-A]\nsampling = \"centre\"\npitch_um = 10.0\n",
+            "circle-A",
+        );
+        assert!(
+            err(&more, &[]).contains("may only set `sampling`"),
+            "{}",
+            err(&more, &[])
+        );
+        let unknown = with("[surfaces.mine]\nsampling = \"centre\"\n", "mine");
+        assert!(
+            err(&unknown, &[]).contains("surfaces.mine.shape: required"),
+            "{}",
+            err(&unknown, &[])
+        );
+        let flat = with(
+            "[surfaces.plain]\nshape = \"flat\"\nsampling = \"area\"\n",
+            "plain",
+        );
+        assert!(
+            err(&flat, &[]).contains("only patterns"),
+            "{}",
+            err(&flat, &[])
+        );
+    }
+
+    #[test]
     fn issue20_item5_a_height_map_is_read_once_and_only_from_a_regular_file() {
         let tmp_dir = tempfile::tempdir().unwrap();
         let dir = tmp_dir.path().to_path_buf();
