@@ -44,7 +44,8 @@
 //! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`
 //! 2. Green's functions: `influence`, `aniso`
 //! 3. description of a case: `material`, `surface`, `presets`, `spec`
-//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables)
+//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables);
+//!    `stress` (stresses below the surface, its own spectral kernels)
 //! 5. single-field solvers: `normal`; `tangential_problem` (the tangential
 //!    solve's inputs and outputs) and `fista` (the shared momentum step) →
 //!    `coarse_slip` → `window` → `tangential`, `tangential_displacement`
@@ -81,6 +82,7 @@ pub mod presets;
 mod progress;
 mod results;
 mod spec;
+pub mod stress;
 mod surface;
 pub mod tangential;
 pub mod tangential_displacement;
