@@ -92,7 +92,9 @@ pub mod window;
 pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
-pub use history::{HistoryOutput, HistoryStep, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION};
+pub use history::{
+    HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,
+};
 pub use kernels::{
     build_operator, build_pair_operator, persists, BuildLock, KernelCache, KernelKey, KernelStore,
     Resident,

@@ -490,3 +490,40 @@ fn a_111_crystal_under_hertz_pressure_shows_three_fold_symmetry() {
     assert!(a120 < 1e-3 * P0 && a240 < 1e-3 * P0, "three-fold");
     assert!(a60 > 10.0 * a120, "not six-fold: the test sees the crystal");
 }
+
+/// A load history keeps the tractions of its turning points (what the
+/// stresses of a fretting cycle are computed from): one per turning step,
+/// the last equal to the case's final fields to the bit.
+#[test]
+fn a_load_history_keeps_the_tractions_of_its_turning_points() {
+    let spec = solver::CaseSpec {
+        material: fe(),
+        surface: solver::Surface::Flat,
+        grid: Grid::square(64, 4e-6),
+        load: solver::Load {
+            indenter_radius_m: 18e-3,
+            normal_force_n: 20.0,
+            friction: 0.3,
+            tangential_ratio: 0.0,
+            angle_deg: 0.0,
+        },
+        numerics: solver::Numerics::default(),
+        history: Some(solver::LoadHistory {
+            tangential_ratios: vec![0.0, 0.5, -0.5],
+            normal_forces_n: None,
+            steps_per_segment: 3,
+            shifts_m: None,
+        }),
+        indenter: None,
+    };
+    let out = solver::solve_case(&spec, &mut solver::KernelCache::new()).unwrap();
+    let h = out.scalars.history.as_ref().unwrap();
+    let steps: Vec<usize> = out.turning.iter().map(|t| t.step).collect();
+    assert_eq!(steps, h.turning_steps);
+    let last = out.turning.last().unwrap();
+    assert!(last.p == out.fields.p && last.qx == out.fields.qx && last.qy == out.fields.qy);
+    // The +F state's force, recovered from its tractions, is +0.5 μP.
+    let da = spec.grid.cell_area();
+    let fx: f64 = out.turning[1].qx.iter().sum::<f64>() * da;
+    assert!((fx / (0.3 * 20.0) - 0.5).abs() < 1e-3, "{fx}");
+}
