@@ -8,10 +8,11 @@ use std::path::Path;
 
 use anyhow::{anyhow, Result};
 use serde::Serialize;
-use solver::stress::{max_principal, tresca, von_mises, Line, StressField, StressPlan};
+use solver::stress::{max_principal, tresca, von_mises, Line, StressField, StressPlan, COMPONENTS};
 use solver::{CaseScalars, CaseSpec, Fields, TurningState};
 
 use crate::config::StressCfg;
+use crate::float_text::fmt_f64;
 
 /// How the Crossland parameter is formed from the states computed.
 pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the usual two turning points of a fretting cycle), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
@@ -354,65 +355,137 @@ const DERIVED: [(&str, Invariant); 3] = [
     ("s1", max_principal),
 ];
 
-/// Writes `stress/` under `dir`: per state (suffix `_stepK` with several)
-/// `plane_<z>um_<c>.npy` (n x n) and `slice_<along|across>_<c>.npy`
-/// (rows = `slice_depths_m`, columns along the line), `c` the six
-/// components (`sxx` … `sxy`, Pa), `von_mises`, `tresca`, `s1`; Crossland
-/// maps with two states or more; von Mises PNGs with the contact edge
-/// marked. Returns the warnings of maps that could not be drawn.
+/// One array of the stresses of a case, as written to `stress/<name>.npy`.
+pub struct StressArray {
+    /// File stem (see [`write`]).
+    pub name: String,
+    /// Rows (y, or the depths of a slice).
+    pub rows: usize,
+    /// Columns (x, or along the slice's line).
+    pub cols: usize,
+    /// Row-major values, Pa.
+    pub data: Vec<f64>,
+}
+
+/// Every array of `so` with its name: per state (suffix `_stepK` when
+/// there are several) `plane_<z>um_<c>` (n x n, rows y, columns x) and
+/// `slice_<along|across>_<c>` (rows = `slice_depths_m`, columns along the
+/// line), `c` the six components (`sxx` … `sxy`), `von_mises`, `tresca`,
+/// `s1`; with two states or more `plane_<z>um_crossland` and
+/// `slice_<along|across>_crossland`. The files of [`write`] and Python's
+/// `Result.stress`.
+pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
+    let n = so.grid.n;
+    let rows = so.scalars.slice_depths_m.len();
+    let many = so.states.len() > 1;
+    let mut out = Vec::new();
+    let mut push = |name: String, rows: usize, data: Vec<f64>| {
+        out.push(StressArray {
+            name,
+            rows,
+            cols: n,
+            data,
+        })
+    };
+    for st in &so.states {
+        let suffix = state_suffix(many, st.step);
+        for (k, f) in st.planes.iter().enumerate() {
+            let stem = format!("plane_{}um{suffix}", fmt_f64(so.depths_um[k]));
+            for (c, name) in COMPONENTS.iter().enumerate() {
+                push(format!("{stem}_{name}"), n, f.components[c].clone());
+            }
+            for (name, g) in DERIVED {
+                push(format!("{stem}_{name}"), n, f.map(g));
+            }
+        }
+        for (label, lines) in [("along", &st.along), ("across", &st.across)] {
+            if lines.is_empty() {
+                continue;
+            }
+            let stem = format!("slice_{label}{suffix}");
+            for (c, name) in COMPONENTS.iter().enumerate() {
+                let vals = lines.iter().flat_map(|f| f.components[c].clone()).collect();
+                push(format!("{stem}_{name}"), rows, vals);
+            }
+            for (name, g) in DERIVED {
+                push(
+                    format!("{stem}_{name}"),
+                    rows,
+                    lines.iter().flat_map(|f| f.map(g)).collect(),
+                );
+            }
+        }
+    }
+    for (k, f) in so.crossland_planes.iter().enumerate() {
+        push(
+            format!("plane_{}um_crossland", fmt_f64(so.depths_um[k])),
+            n,
+            f.clone(),
+        );
+    }
+    if let Some([al, ac]) = &so.crossland_slices {
+        push("slice_along_crossland".into(), rows, al.clone());
+        push("slice_across_crossland".into(), rows, ac.clone());
+    }
+    out
+}
+
+fn state_suffix(many: bool, step: Option<usize>) -> String {
+    match (many, step) {
+        (true, Some(k)) => format!("_step{k}"),
+        _ => String::new(),
+    }
+}
+
+/// Writes `stress/` under `dir`: every array of [`arrays`] as
+/// `<name>.npy`, and von Mises PNG maps (over p_H) of every plane and
+/// slice with the contact edge marked. Returns the warnings of maps that
+/// could not be drawn (the numbers are written first).
 pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> {
     let dir = dir.join("stress");
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("cannot create {}: {e}", dir.display()))?;
+    for arr in arrays(so) {
+        crate::npy::write_npy_2d(
+            &dir.join(format!("{}.npy", arr.name)),
+            arr.rows,
+            arr.cols,
+            &arr.data,
+        )?;
+    }
     let n = so.grid.n;
     let many = so.states.len() > 1;
     let mut warnings = Vec::new();
     let a = so.contact_radius_m;
     let rows = so.scalars.slice_depths_m.len();
     let z_max = so.scalars.slice_depths_m.last().copied().unwrap_or(0.0);
+    let mut draw = |file: String, heat: &crate::maps::Heat| {
+        if let Err(e) = crate::maps::write_heat(&dir.join(&file), heat) {
+            warnings.push(format!("{file} not drawn: {e:#}"));
+        }
+    };
     for st in &so.states {
-        let suffix = match (many, st.step) {
-            (true, Some(k)) => format!("_step{k}"),
-            _ => String::new(),
-        };
+        let suffix = state_suffix(many, st.step);
         for (k, f) in st.planes.iter().enumerate() {
-            let stem = format!(
-                "plane_{}um{suffix}",
-                crate::float_text::fmt_f64(so.depths_um[k])
+            let stem = format!("plane_{}um{suffix}", fmt_f64(so.depths_um[k]));
+            let norm: Vec<f64> = f.map(von_mises).iter().map(|v| v / so.p_h).collect();
+            let marks = plane_edge(&so.grid, &st.p, a);
+            let half = 0.5 * (n as f64 - 1.0);
+            let ext = (so.grid.dx * half / a, so.grid.dy * half / a);
+            let t = format!("{title}, z = {:.3} a{suffix}", so.depths_m[k] / a);
+            draw(
+                format!("{stem}_von_mises.png"),
+                &crate::maps::Heat {
+                    title: &t,
+                    label: "von Mises / p_H",
+                    cols: n,
+                    rows: n,
+                    values: &norm,
+                    x_range: (-ext.0, ext.0),
+                    y_range: (-ext.1, ext.1),
+                    axes: ("x / a", "y / a"),
+                    marks: &marks,
+                },
             );
-            for (c, name) in solver::stress::COMPONENTS.iter().enumerate() {
-                crate::npy::write_npy(
-                    &dir.join(format!("{stem}_{name}.npy")),
-                    n,
-                    &f.components[c],
-                )?;
-            }
-            for (name, g) in DERIVED {
-                let vals = f.map(g);
-                crate::npy::write_npy(&dir.join(format!("{stem}_{name}.npy")), n, &vals)?;
-                if name == "von_mises" {
-                    let norm: Vec<f64> = vals.iter().map(|v| v / so.p_h).collect();
-                    let marks = plane_edge(&so.grid, &st.p, a);
-                    let half = 0.5 * (n as f64 - 1.0);
-                    let ext = (so.grid.dx * half / a, so.grid.dy * half / a);
-                    let t = format!("{title}, z = {:.3} a{suffix}", so.depths_m[k] / a);
-                    let heat = crate::maps::Heat {
-                        title: &t,
-                        label: "von Mises / p_H",
-                        cols: n,
-                        rows: n,
-                        values: &norm,
-                        x_range: (-ext.0, ext.0),
-                        y_range: (-ext.1, ext.1),
-                        axes: ("x / a", "y / a"),
-                        marks: &marks,
-                    };
-                    if let Err(e) =
-                        crate::maps::write_heat(&dir.join(format!("{stem}_von_mises.png")), &heat)
-                    {
-                        warnings.push(format!("{stem}_von_mises.png not drawn: {e:#}"));
-                    }
-                }
-            }
         }
         for (label, lines, line_is_row) in [
             ("along", &st.along, so.along_is_row),
@@ -421,50 +494,30 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
             if lines.is_empty() {
                 continue;
             }
-            let stem = format!("slice_{label}{suffix}");
-            let flat = |g: &dyn Fn([f64; 6]) -> f64| -> Vec<f64> {
-                lines.iter().flat_map(|f| f.map(g)).collect()
-            };
-            for (c, name) in solver::stress::COMPONENTS.iter().enumerate() {
-                let vals: Vec<f64> = lines.iter().flat_map(|f| f.components[c].clone()).collect();
-                crate::npy::write_npy_2d(&dir.join(format!("{stem}_{name}.npy")), rows, n, &vals)?;
-            }
-            for (name, g) in DERIVED {
-                let vals = flat(&g);
-                crate::npy::write_npy_2d(&dir.join(format!("{stem}_{name}.npy")), rows, n, &vals)?;
-                if name == "von_mises" {
-                    let norm: Vec<f64> = vals.iter().map(|v| v / so.p_h).collect();
-                    let d = if line_is_row { so.grid.dx } else { so.grid.dy };
-                    let half = 0.5 * (n as f64 - 1.0) * d / a;
-                    let marks = line_edge(&so.grid, &st.p, so.centre, line_is_row, a);
-                    let t = format!("{title}, slice {label} the force{suffix}");
-                    let heat = crate::maps::Heat {
-                        title: &t,
-                        label: "von Mises / p_H",
-                        cols: n,
-                        rows,
-                        values: &norm,
-                        x_range: (-half, half),
-                        y_range: (0.0, -z_max / a),
-                        axes: (if line_is_row { "x / a" } else { "y / a" }, "-z / a"),
-                        marks: &marks,
-                    };
-                    if let Err(e) =
-                        crate::maps::write_heat(&dir.join(format!("{stem}_von_mises.png")), &heat)
-                    {
-                        warnings.push(format!("{stem}_von_mises.png not drawn: {e:#}"));
-                    }
-                }
-            }
+            let norm: Vec<f64> = lines
+                .iter()
+                .flat_map(|f| f.map(von_mises))
+                .map(|v| v / so.p_h)
+                .collect();
+            let d = if line_is_row { so.grid.dx } else { so.grid.dy };
+            let half = 0.5 * (n as f64 - 1.0) * d / a;
+            let marks = line_edge(&so.grid, &st.p, so.centre, line_is_row, a);
+            let t = format!("{title}, slice {label} the force{suffix}");
+            draw(
+                format!("slice_{label}{suffix}_von_mises.png"),
+                &crate::maps::Heat {
+                    title: &t,
+                    label: "von Mises / p_H",
+                    cols: n,
+                    rows,
+                    values: &norm,
+                    x_range: (-half, half),
+                    y_range: (0.0, -z_max / a),
+                    axes: (if line_is_row { "x / a" } else { "y / a" }, "-z / a"),
+                    marks: &marks,
+                },
+            );
         }
-    }
-    for (k, f) in so.crossland_planes.iter().enumerate() {
-        let stem = format!("plane_{}um", crate::float_text::fmt_f64(so.depths_um[k]));
-        crate::npy::write_npy(&dir.join(format!("{stem}_crossland.npy")), n, f)?;
-    }
-    if let Some([al, ac]) = &so.crossland_slices {
-        crate::npy::write_npy_2d(&dir.join("slice_along_crossland.npy"), rows, n, al)?;
-        crate::npy::write_npy_2d(&dir.join("slice_across_crossland.npy"), rows, n, ac)?;
     }
     Ok(warnings)
 }

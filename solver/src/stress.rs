@@ -278,6 +278,8 @@ pub struct StressPlan {
 pub struct TractionSpectra {
     /// `q̂x, q̂y, p̂`, natural order, `[kx][ky]` (see [`crate::fft2`]).
     spectra: [Vec<C>; 3],
+    /// `qx, qy, p` themselves (the stresses on the surface plane).
+    fields: [Vec<f64>; 3],
 }
 
 /// The kernel spectra of one depth plane (18 half spectra of the padded
@@ -575,7 +577,10 @@ impl StressPlan {
             self.fft.forward_padded(f, &mut s);
             s
         });
-        TractionSpectra { spectra }
+        TractionSpectra {
+            spectra,
+            fields: [qx.to_vec(), qy.to_vec(), p.to_vec()],
+        }
     }
 
     /// The stress on `plane` under `t` (18 spectral products, 6 inverse transforms).
@@ -677,15 +682,9 @@ impl StressPlan {
         field
     }
 
-    /// `qx, qy, p` back from their spectra.
-    fn traction_fields(&mut self, t: &TractionSpectra) -> [Vec<f64>; 3] {
-        let n = self.grid.n;
-        std::array::from_fn(|j| {
-            let mut s = t.spectra[j].clone();
-            let mut out = vec![0.0; n * n];
-            self.fft.inverse_cropped(&mut s, &mut out);
-            out
-        })
+    /// `qx, qy, p` of a state.
+    fn traction_fields(&self, t: &TractionSpectra) -> [Vec<f64>; 3] {
+        t.fields.clone()
     }
 }
 
