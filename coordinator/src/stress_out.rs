@@ -15,7 +15,7 @@ use crate::config::StressCfg;
 use crate::float_text::fmt_f64;
 
 /// How the Crossland parameter is formed from the states computed.
-pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the usual two turning points of a fretting cycle), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
+pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the extremes of a fretting cycle; with more, the smallest enclosing sphere's radius exceeds it by at most 2/sqrt(3) for three states and sqrt(5/3) for more), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
 
 /// Where the maxima are sought.
 pub const MAXIMA_DEFINITION: &str = "maxima over the points computed: every plane of stress.depths_um and the two slices (the grid row and column through the cell nearest the pressure centroid; 'along' is the one nearer the force direction); the surface peak is the stress along the force direction, sigma_tt = sxx c^2 + syy s^2 + 2 sxy s c, on the top row of the 'along' slice";
