@@ -65,6 +65,8 @@ pub struct StressScalars {
     pub slice_depths_m: Vec<f64>,
     /// The slice along the force: `x` (a grid row) or `y` (a column).
     pub slice_along: &'static str,
+    /// The cell centre the slices pass through (x, y), m.
+    pub slice_through_m: [f64; 2],
 }
 
 /// One state's stresses on the planes and slices.
@@ -334,6 +336,7 @@ pub fn compute(
             maxima_definition: MAXIMA_DEFINITION,
             slice_depths_m: slice_depths,
             slice_along: if along_is_row { "x" } else { "y" },
+            slice_through_m: [grid.x(ix0), grid.y(iy0)],
         },
         states: out,
         crossland_planes,
