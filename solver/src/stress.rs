@@ -14,7 +14,10 @@
 //! cell-mean tractions are piecewise constant: the response is multiplied
 //! by the cell's transform and summed over the aliases the grid cannot
 //! resolve, and the product applied by FFT on the zero-padded `2n x 2n`
-//! grid (DC-FFT's padding), so the sources do not wrap around.
+//! grid (DC-FFT's padding). Sampled in frequency, that kernel still carries
+//! its periodic images at the padded period; they are estimated on a coarse
+//! grid and subtracted ([`StressPlan::plane`]), so the convolution is the
+//! non-periodic one of DC-FFT.
 
 use nalgebra::{Matrix3, Matrix6, SMatrix};
 use num_complex::Complex64;
@@ -424,7 +427,7 @@ impl StressPlan {
 
     /// The kernel of the plane at depth `depth_m` (m, ≥ 0): the response
     /// on the padded grid's frequencies, less the periodic images of the
-    /// padded grid ([`StressPlan::images`]).
+    /// padded grid (see `StressPlan::images`).
     pub fn plane(&mut self, depth_m: f64) -> Result<StressPlane, SolverError> {
         check_depth(depth_m)?;
         let n = self.grid.n;
