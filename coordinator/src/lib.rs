@@ -20,3 +20,4 @@ pub mod run;
 pub mod shard;
 pub mod solve;
 pub mod solve_progress;
+pub mod stress_out;

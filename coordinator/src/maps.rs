@@ -192,3 +192,124 @@ pub fn write_maps(
     }
     Ok(())
 }
+
+/// A rectangular map of `values` (`rows x cols`, row major, row 0 at
+/// `y_range.0`) over `x_range x y_range` (cell centres at the ends), with
+/// black marks at `marks`: the stress planes and slices (`stress_out`),
+/// where the marks are the contact edge.
+pub struct Heat<'a> {
+    /// Title above the map.
+    pub title: &'a str,
+    /// Label of the colour bar.
+    pub label: &'a str,
+    /// Columns and rows.
+    pub cols: usize,
+    /// See `cols`.
+    pub rows: usize,
+    /// The values.
+    pub values: &'a [f64],
+    /// First and last column's coordinate.
+    pub x_range: (f64, f64),
+    /// First and last row's coordinate.
+    pub y_range: (f64, f64),
+    /// Axis names.
+    pub axes: (&'a str, &'a str),
+    /// Points to mark.
+    pub marks: &'a [(f64, f64)],
+}
+
+/// Draws a [`Heat`] map into `path` (PNG, written whole or not at all).
+pub fn write_heat(path: &Path, heat: &Heat) -> Result<()> {
+    crate::atomic::replace_with(path, |tmp| draw_heat(tmp, heat))
+}
+
+fn draw_heat(path: &Path, m: &Heat) -> Result<()> {
+    let root = BitMapBackend::new(path, (760, 640)).into_drawing_area();
+    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (main, bar) = root.split_horizontally(620);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in m.values.iter().filter(|v| v.is_finite()) {
+        lo = lo.min(*v);
+        hi = hi.max(*v);
+    }
+    if !(lo.is_finite() && hi > lo) {
+        (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
+    }
+    let step = |r: (f64, f64), k: usize| {
+        if k > 1 {
+            (r.1 - r.0) / (k - 1) as f64
+        } else {
+            1.0
+        }
+    };
+    let (hx, hy) = (0.5 * step(m.x_range, m.cols), 0.5 * step(m.y_range, m.rows));
+    let (x0, x1) = (m.x_range.0 - hx, m.x_range.1 + hx);
+    let (ya, yb) = (m.y_range.0 - hy, m.y_range.1 + hy);
+    let (y0, y1) = (ya.min(yb), ya.max(yb));
+    let mut chart = ChartBuilder::on(&main)
+        .caption(m.title, ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(m.axes.0)
+        .y_desc(m.axes.1)
+        .draw()
+        .map_err(|e| err(&e))?;
+    let (dx, dy) = (2.0 * hx, 2.0 * hy);
+    chart
+        .draw_series((0..m.rows).flat_map(|r| {
+            (0..m.cols).map(move |c| {
+                let x = m.x_range.0 + c as f64 * dx;
+                let y = m.y_range.0 + r as f64 * dy;
+                let t = (m.values[r * m.cols + c] - lo) / (hi - lo);
+                Rectangle::new(
+                    [(x - hx, y - hy.abs()), (x + hx, y + hy.abs())],
+                    ramp(t).filled(),
+                )
+            })
+        }))
+        .map_err(|e| err(&e))?;
+    chart
+        .draw_series(
+            m.marks
+                .iter()
+                .map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())),
+        )
+        .map_err(|e| err(&e))?;
+    let mut cb = ChartBuilder::on(&bar)
+        .caption(m.label, ("sans-serif", 14))
+        .margin_top(12)
+        .margin_bottom(50)
+        .margin_left(8)
+        .margin_right(8)
+        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(|e| err(&e))?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let steps = 200;
+    cb.draw_series((0..steps).map(|k| {
+        let (v0, v1) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+        );
+        Rectangle::new(
+            [(0.0, v0), (1.0, v1)],
+            ramp((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))
+    .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}

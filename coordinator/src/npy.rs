@@ -11,11 +11,16 @@ use solver::Fields;
 
 /// Writes one `n x n` field as a 2-D float64 `.npy` (rows = y, columns = x).
 pub fn write_npy(path: &Path, n: usize, data: &[f64]) -> Result<()> {
+    write_npy_2d(path, n, n, data)
+}
+
+/// Writes a `rows x cols` array (row major) as a 2-D float64 `.npy`.
+pub fn write_npy_2d(path: &Path, rows: usize, cols: usize, data: &[f64]) -> Result<()> {
     crate::atomic::replace_with(path, |tmp| {
         let file = std::fs::File::create(tmp)?;
         let mut w = npyz::WriteOptions::new()
             .default_dtype()
-            .shape(&[n as u64, n as u64])
+            .shape(&[rows as u64, cols as u64])
             .writer(BufWriter::new(file))
             .begin_nd()?;
         w.extend(data.iter().copied())?;

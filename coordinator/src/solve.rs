@@ -61,6 +61,10 @@ pub struct CaseJson<'a> {
     /// With a load history: how the slip regime is decided.
     #[serde(skip_serializing_if = "Option::is_none")]
     slip_regime_definition: Option<&'static str>,
+    /// With `[stress]`: maxima below the surface, the surface peak and
+    /// the fatigue parameter (`crate::stress_out`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stress: Option<&'a crate::stress_out::StressScalars>,
 }
 
 /// Options of `mpcontact solve`.
@@ -93,6 +97,8 @@ pub struct CaseChoice {
     pub angle_deg: f64,
     /// The spec, validated.
     pub spec: CaseSpec,
+    /// `[stress]` of the config: stresses below the surface after the solve.
+    pub stress: Option<crate::config::StressCfg>,
 }
 
 impl CaseChoice {
@@ -162,6 +168,7 @@ impl CaseChoice {
             surface: surface.to_string(),
             angle_deg,
             spec,
+            stress: config.stress.clone(),
         })
     }
 }
@@ -174,6 +181,8 @@ pub struct Solved {
     pub scalars: CaseScalars,
     /// Fields of the case itself.
     pub fields: Fields,
+    /// With `[stress]`: the stresses below the surface.
+    pub stress: Option<crate::stress_out::StressOutput>,
 }
 
 impl Solved {
@@ -210,6 +219,7 @@ impl Solved {
             slip_regime_definition: h
                 .and_then(|h| h.regime.as_ref())
                 .map(|_| solver::SLIP_REGIME_DEFINITION),
+            stress: self.stress.as_ref().map(|s| &s.scalars),
         }
     }
 }
@@ -243,10 +253,21 @@ pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
         };
         calibrate_on_flat(&mut scalars, &flat, &spec.load);
     }
+    let stress = match &case.stress {
+        Some(cfg) => Some(crate::stress_out::compute(
+            cfg,
+            spec,
+            &scalars,
+            &out.fields,
+            &out.turning,
+        )?),
+        None => None,
+    };
     Ok(Solved {
         case,
         scalars,
         fields: out.fields,
+        stress,
     })
 }
 
@@ -270,6 +291,11 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
         crate::maps::write_maps(out, &title, &solved.fields, &solved.scalars, c.spec.grid.dx)
     {
         eprintln!("warning: maps not written: {e:#}");
+    }
+    if let Some(stress) = &solved.stress {
+        for w in crate::stress_out::write(out, stress, &title)? {
+            eprintln!("warning: {w}");
+        }
     }
     Ok(())
 }

@@ -87,6 +87,14 @@ fn accepted_keys() -> BTreeSet<String> {
             cycles: 2,
         }),
     });
+    c.stress = Some(coordinator::config::StressCfg {
+        depths_um: vec![0.0, 10.0],
+        slices: true,
+        slice_depth_um: Some(50.0),
+        slice_rows: 11,
+        states: "turning".into(),
+        crossland_alpha: 0.3,
+    });
     let v = toml::Value::try_from(&c).unwrap();
     let mut keys = BTreeSet::new();
     walk("", &v, &mut keys);

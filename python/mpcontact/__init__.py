@@ -44,14 +44,18 @@ class Result:
     ``scalars``: dict with exactly the keys and values of the CLI's
     ``case.json`` (same serde value). ``fields``: dict of float64 ``(n, n)``
     arrays, rows along y, SI units (Pa, m; ``stick`` is 0/1) — the CLI's
-    ``.npy`` files.
+    ``.npy`` files. ``stress``: with a ``[stress]`` section, dict of the
+    stresses below the surface named as the CLI's ``stress/*.npy`` files
+    (``plane_<z>um_<c>``, ``slice_along_<c>``, …; Pa), else ``None``; their
+    maxima are in ``scalars["stress"]``.
     """
 
-    __slots__ = ("scalars", "fields")
+    __slots__ = ("scalars", "fields", "stress")
 
-    def __init__(self, scalars, fields):
+    def __init__(self, scalars, fields, stress=None):
         self.scalars = scalars
         self.fields = fields
+        self.stress = stress
 
     @property
     def spacing_m(self):
@@ -141,7 +145,7 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
         name = None
     if angle_deg is not None:
         angle_deg = float(angle_deg)
-    scalars, fields = _native.solve(
+    scalars, fields, stress = _native.solve(
         cfg,
         material=material,
         surface=name,
@@ -149,7 +153,7 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
         angle_deg=angle_deg,
         indenter=indenter,
     )
-    return Result(scalars, fields)
+    return Result(scalars, fields, stress)
 
 
 def kernel(material, angles_deg, cfg=None):

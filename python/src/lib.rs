@@ -348,8 +348,16 @@ enum SurfaceArg {
     Heights(Vec<f64>),
 }
 
-/// Solves one case: `(scalars, fields)` — `scalars` is the CLI's
-/// `case.json` as a dict, `fields` the `.npy` fields as `(n, n)` arrays.
+/// What `solve` returns: `case.json`, the fields, the stress arrays.
+type SolveOutput<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    Option<Bound<'py, PyDict>>,
+);
+
+/// Solves one case: `(scalars, fields, stress)` — `scalars` is the CLI's
+/// `case.json` as a dict, `fields` the `.npy` fields as `(n, n)` arrays,
+/// `stress` (with `[stress]`, else `None`) the arrays of `stress/*.npy`.
 /// `heights` (µm, `(n, n)`, rows along y) replaces the named surface.
 #[pyfunction]
 #[pyo3(signature = (cfg, material=None, surface=None, heights=None, angle_deg=None, label="array", indenter=None))]
@@ -363,7 +371,7 @@ fn solve<'py>(
     angle_deg: Option<f64>,
     label: &str,
     indenter: Option<String>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+) -> PyResult<SolveOutput<'py>> {
     let config = &cfg.config;
     let n = config.grid.points;
     let arg = match heights {
@@ -414,7 +422,21 @@ fn solve<'py>(
     for (name, data) in solved.fields.named() {
         fields.set_item(name, PyArray1::from_slice(py, data).reshape([n, n])?)?;
     }
-    Ok((scalars, fields))
+    // With [stress]: the arrays of the CLI's stress/*.npy, by file stem.
+    let stress = match &solved.stress {
+        Some(so) => {
+            let d = PyDict::new(py);
+            for a in coordinator::stress_out::arrays(so) {
+                d.set_item(
+                    &a.name,
+                    PyArray1::from_slice(py, &a.data).reshape([a.rows, a.cols])?,
+                )?;
+            }
+            Some(d)
+        }
+        None => None,
+    };
+    Ok((scalars, fields, stress))
 }
 
 /// The surface compliance H(θ) of a material at each angle (degrees), 1/Pa:

@@ -265,3 +265,26 @@ def test_a_ball_of_the_sweep_axis_solves_from_python_as_from_the_cli(tmp_path, c
     )
     with pytest.raises(ValueError, match="indenter: unknown material `unobtainium`"):
         mpcontact.solve(cfg, indenter="unobtainium")
+
+
+def test_stress_below_the_surface_equals_the_cli_bit_for_bit(tmp_path, cli_solve):
+    # Issue #38: with [stress], Result.stress holds the CLI's stress/*.npy
+    # arrays and scalars["stress"] its case.json entry; without, None.
+    path = tmp_path / "stress.toml"
+    path.write_text(
+        mindlin_text(ratio=0.6)
+        + "\n[stress]\ndepths_um = [0.0, 20.0]\nslice_rows = 6\n"
+    )
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert without_times(res.scalars) == without_times(case_json)
+    names = {p.stem for p in (cli_dir / "stress").glob("*.npy")}
+    assert names == set(res.stress), names ^ set(res.stress)
+    for name in names:
+        theirs = np.load(cli_dir / "stress" / f"{name}.npy")
+        assert res.stress[name].tobytes() == theirs.tobytes(), name
+    # σzz = −p on the surface plane, cell by cell.
+    assert np.array_equal(res.stress["plane_0um_szz"], -res.fields["p"])
+    plain = tmp_path / "plain.toml"
+    plain.write_text(mindlin_text(ratio=0.6))
+    assert mpcontact.solve(mpcontact.Config.from_toml(plain)).stress is None

@@ -83,6 +83,7 @@ fn solve_history_case(
     last_spec.load.normal_force_n = p_last;
     last_spec.load.tangential_ratio = (f_last / (spec.load.friction * p_last)).max(0.0);
     let converged = solved.converged;
+    let turning = solved.turning;
     let mut out = reduce(
         &last_spec,
         &mut res.operator,
@@ -92,5 +93,6 @@ fn solve_history_case(
         Some(solved.output),
     )?;
     out.scalars.converged &= converged;
+    out.turning = turning;
     Ok(out)
 }

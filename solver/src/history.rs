@@ -91,6 +91,31 @@ pub struct HistoryOutput {
 /// How [`HistoryOutput::regime`] is decided.
 pub const SLIP_REGIME_DEFINITION: &str = "a full cycle is in gross slip when at some increment of it no contact cell sticks (every traction on its friction disc: the whole contact slides), in partial slip otherwise; the path is `partial` or `gross` when all its full cycles are, `mixed` when they differ";
 
+/// The tractions of the state at a turning point of the path (what the
+/// stresses below the surface of a load history are computed from).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TurningState {
+    /// The increment (a row of [`HistoryOutput::steps`]).
+    pub step: usize,
+    /// Pressure, Pa (row major, as [`crate::Fields`]).
+    pub p: Vec<f64>,
+    /// Shear traction x, Pa.
+    pub qx: Vec<f64>,
+    /// Shear traction y, Pa.
+    pub qy: Vec<f64>,
+}
+
+impl TurningState {
+    fn of(step: usize, state: &ContactState) -> Self {
+        TurningState {
+            step,
+            p: state.p.clone(),
+            qx: state.tangential.qx.clone(),
+            qy: state.tangential.qy.clone(),
+        }
+    }
+}
+
 /// Sums of the solves over all increments.
 pub(crate) struct HistoryState {
     /// The state after the last increment (iteration counts summed over all).
@@ -99,6 +124,8 @@ pub(crate) struct HistoryState {
     pub converged: bool,
     /// The path's table and its reductions.
     pub output: HistoryOutput,
+    /// The states at the turning points, the start first.
+    pub turning: Vec<TurningState>,
 }
 
 /// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
@@ -195,6 +222,7 @@ pub(crate) fn solve_history(
     rows[0].stick_area_m2 = rows[0].contact_area_m2;
     let mut force_error_max: f64 = 0.0;
     let mut turning_steps = vec![0];
+    let mut turning = vec![TurningState::of(0, &last)];
     let (mut p_prev, mut f_prev) = points[0];
 
     for (segment, pair) in points.windows(2).enumerate() {
@@ -335,6 +363,7 @@ pub(crate) fn solve_history(
             (p_prev, f_prev) = (p_k, f_k);
         }
         turning_steps.push(rows.len() - 1);
+        turning.push(TurningState::of(rows.len() - 1, &last));
     }
     // The final state's shift is δt from the start of the path, not the
     // last increment's.
@@ -347,6 +376,7 @@ pub(crate) fn solve_history(
         last,
         converged,
         output,
+        turning,
     })
 }
 

@@ -44,7 +44,8 @@
 //! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`, `cover`
 //! 2. Green's functions: `influence`, `aniso`
 //! 3. description of a case: `material`, `surface`, `presets`, `spec`
-//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables)
+//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables);
+//!    `stress` (stresses below the surface, its own spectral kernels)
 //! 5. single-field solvers: `normal`; `tangential_problem` (the tangential
 //!    solve's inputs and outputs) and `fista` (the shared momentum step) →
 //!    `coarse_slip` → `window` → `tangential`, `tangential_displacement`
@@ -83,6 +84,7 @@ pub mod presets;
 mod progress;
 mod results;
 mod spec;
+pub mod stress;
 mod surface;
 pub mod tangential;
 pub mod tangential_displacement;
@@ -92,7 +94,9 @@ pub mod window;
 pub use case::solve_case;
 pub use error::SolverError;
 pub use grid::Grid;
-pub use history::{HistoryOutput, HistoryStep, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION};
+pub use history::{
+    HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,
+};
 pub use kernels::{
     build_operator, build_pair_operator, persists, BuildLock, KernelCache, KernelKey, KernelStore,
     Resident,

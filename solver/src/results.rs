@@ -142,6 +142,9 @@ pub struct CaseOutput {
     pub scalars: CaseScalars,
     /// Fields.
     pub fields: Fields,
+    /// With a load history: the tractions at its turning points (empty
+    /// without one).
+    pub turning: Vec<crate::history::TurningState>,
 }
 
 /// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
@@ -425,5 +428,9 @@ pub(crate) fn reduce(
         uy,
         uz,
     };
-    Ok(CaseOutput { scalars: s, fields })
+    Ok(CaseOutput {
+        scalars: s,
+        fields,
+        turning: Vec::new(),
+    })
 }

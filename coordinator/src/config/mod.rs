@@ -7,7 +7,7 @@
 //! solver error. Each section has its own file with its keys, defaults,
 //! checks and the config keys of its solver parameters, so that a new key
 //! lives in one place: `grid` (`[grid]`, `[indenter]`, `[load]`),
-//! `convergence`, `sweep`, `materials`, `surfaces`, `history` and `solving`
+//! `convergence`, `sweep`, `materials`, `surfaces`, `history`, `stress` and `solving`
 //! (`[solver]`, `[run]`, `[output]`); `toml_text` guards the text itself.
 
 mod convergence;
@@ -15,6 +15,7 @@ mod grid;
 mod history;
 mod materials;
 mod solving;
+mod stress;
 mod surfaces;
 mod sweep;
 mod toml_text;
@@ -24,6 +25,7 @@ pub use grid::{GridCfg, IndenterCfg, LoadCfg};
 pub use history::{FrettingCfg, HistoryCfg, MAX_CYCLES};
 pub use materials::{CubicCfg, IsoCfg, MaterialCfg};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};
+pub use stress::StressCfg;
 pub use surfaces::{heightmap_surface, SurfaceCfg};
 pub use sweep::{AnglesCfg, SweepCfg, MAX_ANGLES, RIGID};
 
@@ -69,6 +71,10 @@ pub struct Config {
     /// `[history]`: a load path for every case (none: one monotonic step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<HistoryCfg>,
+    /// `[stress]`: stresses below the surface (none: not computed; left
+    /// out of the echo then, so journals and outputs are as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stress: Option<StressCfg>,
     /// Directory that relative paths in the config (height maps) start from.
     #[serde(skip)]
     pub base_dir: std::path::PathBuf,
@@ -199,6 +205,9 @@ impl Config {
         self.run.check()?;
         self.sweep.check_unique(&self.sweep.angles_deg.values()?)?;
         self.convergence.check()?;
+        if let Some(s) = &self.stress {
+            s.check()?;
+        }
         let amplitude = self.sweep.amplitude_axis()[0];
         match &self.history {
             Some(h) => {

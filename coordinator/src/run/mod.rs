@@ -79,6 +79,11 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
+    // Not silently dropped: a sweep's workers do not compute stresses (yet).
+    anyhow::ensure!(
+        args.config.stress.is_none(),
+        "[stress]: stresses below the surface are computed by `mpcontact solve` and the Python module, not yet by sweeps; solve the cases of interest one by one, or leave the section out"
+    );
     if args.out_dir.exists() && !args.out_dir.is_dir() {
         anyhow::bail!(
             "--out {}: exists and is not a directory",

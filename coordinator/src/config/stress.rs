@@ -1,0 +1,128 @@
+//! `[stress]`: stresses below the surface (issue #38), opt-in. Without the
+//! section nothing is computed and every output is as before. The
+//! computation is `solver::stress`; the files and scalars `crate::stress_out`.
+
+use anyhow::{bail, Result};
+use serde::{Deserialize, Serialize};
+
+/// Most depth planes (each costs a kernel of 18 padded spectra).
+pub const MAX_DEPTHS: usize = 64;
+/// Most depth rows of a slice.
+pub const MAX_SLICE_ROWS: usize = 256;
+
+/// `[stress]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StressCfg {
+    /// Depths of the horizontal planes, µm (each ≥ 0; none: no planes).
+    #[serde(default)]
+    pub depths_um: Vec<f64>,
+    /// Vertical slices through the contact centre along and across the force.
+    #[serde(default = "yes")]
+    pub slices: bool,
+    /// Deepest row of the slices, µm (default: twice the contact radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slice_depth_um: Option<f64>,
+    /// Depth rows of a slice, the surface included.
+    #[serde(default = "default_rows")]
+    pub slice_rows: usize,
+    /// Which states of a load history: `turning` (its turning points) or
+    /// `final` (the last increment). A case without a history has one state.
+    #[serde(default = "turning")]
+    pub states: String,
+    /// Crossland's coefficient α of the largest hydrostatic stress
+    /// (`√J2,a + α σH,max`), for the fretting-fatigue parameter.
+    #[serde(default = "default_alpha")]
+    pub crossland_alpha: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+fn default_rows() -> usize {
+    41
+}
+fn turning() -> String {
+    "turning".into()
+}
+fn default_alpha() -> f64 {
+    0.3
+}
+
+impl StressCfg {
+    /// Checks the section; errors name the key.
+    pub(super) fn check(&self) -> Result<()> {
+        if self.depths_um.len() > MAX_DEPTHS {
+            bail!(
+                "stress.depths_um: {} depths, at most {MAX_DEPTHS} (each plane holds 18 spectra of the padded grid)",
+                self.depths_um.len()
+            );
+        }
+        for &d in &self.depths_um {
+            if !d.is_finite() || d < 0.0 {
+                bail!("stress.depths_um: {d} is not a depth below the surface (µm, ≥ 0)");
+            }
+        }
+        if let Some(d) = self.slice_depth_um {
+            if !d.is_finite() || d <= 0.0 {
+                bail!("stress.slice_depth_um = {d}: must be positive (µm)");
+            }
+        }
+        if !(2..=MAX_SLICE_ROWS).contains(&self.slice_rows) {
+            bail!(
+                "stress.slice_rows = {}: must be 2 to {MAX_SLICE_ROWS}",
+                self.slice_rows
+            );
+        }
+        if self.states != "turning" && self.states != "final" {
+            bail!(
+                "stress.states = \"{}\": must be \"turning\" (the load history's turning points) or \"final\"",
+                self.states
+            );
+        }
+        if !self.crossland_alpha.is_finite() || self.crossland_alpha < 0.0 {
+            bail!(
+                "stress.crossland_alpha = {}: must be finite and ≥ 0",
+                self.crossland_alpha
+            );
+        }
+        if self.depths_um.is_empty() && !self.slices {
+            bail!(
+                "stress: neither depths_um nor slices: nothing to compute (leave the section out)"
+            );
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+
+    const BASE: &str = "[grid]\npoints = 64\nspacing_um = 2.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.3\n[sweep]\nmaterials = [\"Fe\"]\n";
+
+    fn err(stress: &str) -> String {
+        let text = format!("{BASE}[stress]\n{stress}\n");
+        format!("{:#}", Config::parse(&text, &[]).unwrap_err())
+    }
+
+    #[test]
+    fn issue38_bad_stress_keys_are_named() {
+        assert!(err("depths_um = [-1.0]").contains("stress.depths_um"));
+        assert!(err("slice_depth_um = 0.0").contains("stress.slice_depth_um"));
+        assert!(err("slice_rows = 1").contains("stress.slice_rows"));
+        assert!(err("states = \"all\"").contains("stress.states"));
+        assert!(err("crossland_alpha = -1.0").contains("stress.crossland_alpha"));
+        assert!(err("slices = false").contains("nothing to compute"));
+        assert!(err("depth_um = [1.0]").contains("depth_um"));
+    }
+
+    #[test]
+    fn issue38_no_section_no_stress_and_defaults_with_one() {
+        let c = Config::parse(BASE, &[]).unwrap();
+        assert!(c.stress.is_none());
+        let c = Config::parse(&format!("{BASE}[stress]\ndepths_um = [5.0]\n"), &[]).unwrap();
+        let s = c.stress.unwrap();
+        assert!(s.slices && s.slice_rows == 41 && s.states == "turning");
+    }
+}
