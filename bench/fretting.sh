@@ -9,6 +9,7 @@
 #
 # Usage: bench/fretting.sh [SIZES]   (default "256:1 512:0.5", points:spacing_um)
 #        MPCONTACT_EXE=/path/to/mpcontact bench/fretting.sh [SIZES]
+#        THREADS=1 bench/fretting.sh [SIZES]   (solve's --threads; default all cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # MPCONTACT_EXE: another build's binary (e.g. main's, for alternating runs).
@@ -26,7 +27,7 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for s in $sizes; do
   n=${s%%:*}; h=${s##*:}
   for coupling in true false; do
-    set_args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling)
+    set_args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling ${THREADS:+--threads $THREADS})
     $exe solve configs/paper-1a-fe.toml "${set_args[@]}" --out "$tmp/m" > /dev/null
     $exe solve configs/fretting-fe.toml "${set_args[@]}" --set history.fretting.cycles=1 --out "$tmp/f" > /dev/null
     ms=$(field "$tmp/m/case.json" seconds); mi=$(field "$tmp/m/case.json" tangential_iterations)
