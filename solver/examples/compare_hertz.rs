@@ -293,6 +293,7 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
             slip_floor: 0.0,
             max_iterations: 20_000,
             start: TangentialStart::Proportional,
+            precondition: false,
         };
         let in_situ = in_situ_ratio(|| {
             res.solve_tangential(&prob).expect("tangential solve");

@@ -14,7 +14,7 @@
 
 use crate::error::SolverError;
 use crate::grid::Grid;
-use crate::multilevel::{coarse_table, prolong, restrict};
+use crate::multilevel::{coarse_table, prolong, restrict, FourierPrecond};
 use crate::operator::{Operator, X, Y};
 use crate::tangential_problem::{TangentialProblem, TangentialSolution, TangentialStart};
 
@@ -26,6 +26,9 @@ pub struct TangentialLevels {
     /// Cells per side of the grid the levels were made for.
     fine_n: usize,
     levels: Vec<Operator>,
+    /// The fine grid's Fourier preconditioner for the warm-started solves
+    /// that ask for it (made on first use, kept with the levels of its grid).
+    pub(crate) fourier: Option<FourierPrecond>,
 }
 
 impl TangentialLevels {
@@ -69,6 +72,7 @@ impl TangentialLevels {
         TangentialLevels {
             fine_n: grid.n,
             levels,
+            fourier: None,
         }
     }
 

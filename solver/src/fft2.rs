@@ -343,9 +343,15 @@ impl Fft2 {
     }
 
     /// Runs the stages on `threads` from now on (buffers for its tasks are
-    /// made here, not in the transforms).
+    /// made here, not in the transforms), or on the calling thread alone
+    /// when the transform is smaller than [`Threads::min_side`].
     pub fn set_threads(&mut self, threads: &Threads) {
-        self.threads = threads.clone();
+        self.threads = if self.m >= threads.min_side() {
+            threads.clone()
+        } else {
+            Threads::serial()
+        };
+        let threads = &self.threads;
         let want = threads.tasks();
         self.tasks.truncate(want);
         while self.tasks.len() < want {

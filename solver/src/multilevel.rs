@@ -59,6 +59,12 @@ impl FourierPrecond {
         self.fft.set_threads(threads);
     }
 
+    /// The mean of the `|k|` symbol over the spectrum, 1/m: the diagonal of
+    /// `W` in real space, what `W` does to one cell's value.
+    pub fn symbol_mean(&self) -> f64 {
+        self.symbol.iter().sum::<f64>() / self.symbol.len() as f64
+    }
+
     /// `z = Π W Π g` over the cells where `active` is true (`z` is zero elsewhere).
     /// (`z` holds the intermediate fields: no field-sized buffer of its own.)
     pub fn apply(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {

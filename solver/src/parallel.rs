@@ -20,10 +20,23 @@ use crate::error::SolverError;
 /// thread slowed by other load on the machine hands work to the others.
 const TASKS_PER_THREAD: usize = 4;
 
+/// Transform side (padded, or periodic) from which a transform's row and
+/// column stages are shared among threads ([`Threads::min_side`]). Below it a
+/// stage is too short for the hand-over between threads to pay, and a case
+/// with 2 threads was slower than with one (rigid sphere on Fe, 80² grid, 20
+/// force increments: 0.34 s → 0.70 s on a machine shared with other work).
+/// One tangential CG iteration's transforms (`tangential_step` example,
+/// fastest of 31, same machine), 1 → 2 threads: 128² (side 256) 0.635 →
+/// 0.667 ms, 192² (384) 1.72–1.77 → 1.67 ms, 256² (512) 3.27–3.44 →
+/// 2.97–3.00 ms.
+pub const PARALLEL_FROM: usize = 512;
+
 /// The threads of one case: serial (the calling thread only) or a rayon pool.
 #[derive(Clone, Default)]
 pub struct Threads {
     pool: Option<Arc<rayon::ThreadPool>>,
+    /// Smaller transforms run serial (0 in a `Default`: see `min_side`).
+    min_side: usize,
 }
 
 impl std::fmt::Debug for Threads {
@@ -35,7 +48,10 @@ impl std::fmt::Debug for Threads {
 impl Threads {
     /// The calling thread only (what a sweep's worker uses: processes fill the cores).
     pub fn serial() -> Self {
-        Threads { pool: None }
+        Threads {
+            pool: None,
+            min_side: PARALLEL_FROM,
+        }
     }
 
     /// `n` threads; 1 is [`Threads::serial`]. Fails for 0 or when the
@@ -50,6 +66,7 @@ impl Threads {
                 .build()
                 .map(|p| Threads {
                     pool: Some(Arc::new(p)),
+                    min_side: PARALLEL_FROM,
                 })
                 .map_err(|e| {
                     SolverError::invalid("threads", format!("cannot start {n} threads: {e}"))
@@ -60,6 +77,24 @@ impl Threads {
     /// The cores of this machine (at least 1): the default of `mpcontact solve`.
     pub fn available() -> usize {
         std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
+
+    /// The same threads for transforms of every size, however small (for
+    /// tests that must run the shared stages on small grids).
+    pub fn at_every_size(mut self) -> Self {
+        self.min_side = 1;
+        self
+    }
+
+    /// Side of the smallest transform whose stages these threads share;
+    /// smaller ones run on the calling thread ([`PARALLEL_FROM`] unless
+    /// [`Threads::at_every_size`]).
+    pub fn min_side(&self) -> usize {
+        if self.min_side == 0 {
+            PARALLEL_FROM
+        } else {
+            self.min_side
+        }
     }
 
     /// Number of threads.
@@ -93,11 +128,12 @@ impl Threads {
 
     /// True when both are the same pool (or both serial).
     pub(crate) fn same(&self, other: &Threads) -> bool {
-        match (&self.pool, &other.pool) {
+        let pools = match (&self.pool, &other.pool) {
             (None, None) => true,
             (Some(a), Some(b)) => Arc::ptr_eq(a, b),
             _ => false,
-        }
+        };
+        pools && self.min_side() == other.min_side()
     }
 }
 
@@ -117,5 +153,9 @@ mod tests {
         assert_eq!(two.count(), 2);
         assert_eq!(two.tasks(), 2 * TASKS_PER_THREAD);
         assert!(two.same(&two.clone()) && !two.same(&one));
+        assert_eq!(two.min_side(), PARALLEL_FROM);
+        let every = two.clone().at_every_size();
+        assert_eq!(every.min_side(), 1);
+        assert!(!every.same(&two));
     }
 }

@@ -98,4 +98,8 @@ pub struct TangentialProblem<'a> {
     pub max_iterations: usize,
     /// Starting state of the iteration.
     pub start: TangentialStart<'a>,
+    /// Precondition the conjugate gradient's stick cells with the Fourier
+    /// inverse of the compliance (a load history's increments, which start
+    /// next to their solution); false: the diagonal (Jacobi) preconditioner.
+    pub precondition: bool,
 }
