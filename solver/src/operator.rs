@@ -252,9 +252,10 @@ pub const CUT_CELL_BETA: f64 = 0.4;
 /// `K_ii(0, 0) (factor − 1) t_i` to each cut cell's displacement.
 #[derive(Clone, Debug)]
 struct CutCells {
-    /// The cover of every cell (1 where whole), row-major.
-    cover: Vec<f64>,
-    /// The cut cells and their extra factor `cover^(-1/2) − 1`.
+    /// The cover of every cell (1 where whole), row-major; `None` on a
+    /// coarse level, whose extra diagonal is the fine one's restriction.
+    cover: Option<Vec<f64>>,
+    /// The cut cells and their extra factor (`factor − 1`).
     extra: Vec<(usize, f64)>,
 }
 
@@ -267,7 +268,7 @@ impl CutCells {
             .map(|(i, &c)| (i, cut_self_factor(c) - 1.0))
             .collect();
         CutCells {
-            cover: cover.to_vec(),
+            cover: Some(cover.to_vec()),
             extra,
         }
     }
@@ -640,7 +641,34 @@ impl Operator {
 
     /// The cover set by [`Operator::set_cover`], if any cell is cut.
     pub fn cover(&self) -> Option<&[f64]> {
-        self.cut.as_ref().map(|c| c.cover.as_slice())
+        self.cut.as_ref().and_then(|c| c.cover.as_deref())
+    }
+
+    /// The cut cells' extra own compliance, m/Pa, as the mean of the two
+    /// tangential components: `(cell, K(0,0) (factor − 1))`; `None` without
+    /// cut cells (what a coarse level restricts, [`Operator::set_extra_diagonal`]).
+    pub fn extra_diagonal(&self) -> Option<Vec<(usize, f64)>> {
+        let cut = self.cut.as_ref()?;
+        Some(
+            cut.extra
+                .iter()
+                .map(|&(c, e)| (c, e * self.tangential_self))
+                .collect(),
+        )
+    }
+
+    /// A coarse level's extra diagonal (m/Pa per cell, the Galerkin
+    /// restriction of the fine grid's cut cells), or none: added to its
+    /// tangential components as a cut cell's is. Results of a fine solve do
+    /// not depend on it (a coarse level only starts the fine solve).
+    pub fn set_extra_diagonal(&mut self, extra: Option<&[(usize, f64)]>) {
+        let k = self.tangential_self;
+        self.cut = extra
+            .filter(|e| !e.is_empty() && k > 0.0)
+            .map(|e| CutCells {
+                cover: None,
+                extra: e.iter().map(|&(c, d)| (c, d / k)).collect(),
+            });
     }
 
     /// Multiplies the cut cells' entries of `v` by `factor^(-1/2)` (their

@@ -266,7 +266,10 @@ fn solve_nested_taking(
         }
         return sol;
     }
-    let Some((qx, qy, coarse)) = coarse_start(levels, prob, solve_tangential_on_grid)? else {
+    let extra = op.extra_diagonal();
+    let Some((qx, qy, coarse)) =
+        coarse_start(levels, prob, solve_tangential_on_grid, extra.as_deref())?
+    else {
         return on_grid_taking(op, prob, None, None);
     };
     let mut sol = on_grid_taking(op, prob, Some((qx, qy)), None)?;
