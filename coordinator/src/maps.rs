@@ -36,6 +36,45 @@ struct Map<'a> {
     values: Vec<f64>,
 }
 
+/// The colour bar beside a map: the ramp from `lo` to `hi` under `label`.
+fn colour_bar(
+    bar: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    label: &str,
+    lo: f64,
+    hi: f64,
+) -> Result<()> {
+    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
+    let mut cb = ChartBuilder::on(bar)
+        .caption(label, ("sans-serif", 14))
+        .margin_top(12)
+        .margin_bottom(50)
+        .margin_left(8)
+        .margin_right(8)
+        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(|e| err(&e))?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let steps = 200;
+    cb.draw_series((0..steps).map(|k| {
+        let (v0, v1) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+        );
+        Rectangle::new(
+            [(0.0, v0), (1.0, v1)],
+            ramp((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))
+    .map_err(|e| err(&e))?;
+    Ok(())
+}
+
 fn draw_map(
     path: &Path,
     title: &str,
@@ -90,35 +129,7 @@ fn draw_map(
             })
         }))
         .map_err(|e| err(&e))?;
-    // Colour bar.
-    let mut cb = ChartBuilder::on(&bar)
-        .caption(map.label, ("sans-serif", 14))
-        .margin_top(12)
-        .margin_bottom(50)
-        .margin_left(8)
-        .margin_right(8)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(|e| err(&e))?;
-    cb.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| format!("{v:.3}"))
-        .draw()
-        .map_err(|e| err(&e))?;
-    let steps = 200;
-    cb.draw_series((0..steps).map(|k| {
-        let (v0, v1) = (
-            lo + (hi - lo) * k as f64 / steps as f64,
-            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
-        );
-        Rectangle::new(
-            [(0.0, v0), (1.0, v1)],
-            ramp((k as f64 + 0.5) / steps as f64).filled(),
-        )
-    }))
-    .map_err(|e| err(&e))?;
+    colour_bar(&bar, map.label, lo, hi)?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
@@ -282,34 +293,7 @@ fn draw_heat(path: &Path, m: &Heat) -> Result<()> {
                 .map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())),
         )
         .map_err(|e| err(&e))?;
-    let mut cb = ChartBuilder::on(&bar)
-        .caption(m.label, ("sans-serif", 14))
-        .margin_top(12)
-        .margin_bottom(50)
-        .margin_left(8)
-        .margin_right(8)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(|e| err(&e))?;
-    cb.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| format!("{v:.3}"))
-        .draw()
-        .map_err(|e| err(&e))?;
-    let steps = 200;
-    cb.draw_series((0..steps).map(|k| {
-        let (v0, v1) = (
-            lo + (hi - lo) * k as f64 / steps as f64,
-            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
-        );
-        Rectangle::new(
-            [(0.0, v0), (1.0, v1)],
-            ramp((k as f64 + 0.5) / steps as f64).filled(),
-        )
-    }))
-    .map_err(|e| err(&e))?;
+    colour_bar(&bar, m.label, lo, hi)?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }

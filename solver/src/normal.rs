@@ -56,6 +56,9 @@ trait ZzApply {
 struct Fine<'a> {
     op: &'a mut Operator,
     precond: &'a mut Option<FourierPrecond>,
+    /// The scaled residual on a grid with cut cells (one per solve, not
+    /// per iteration).
+    scaled: Vec<f64>,
 }
 
 impl ZzApply for Fine<'_> {
@@ -77,9 +80,10 @@ impl ZzApply for Fine<'_> {
         // by `factor`; a symmetric Jacobi scaling around the Fourier inverse
         // keeps them from slowing the iteration (quick sweep, circle-A at
         // 128² of 60 µm: 169 iterations without it).
-        let mut scaled = g.to_vec();
-        self.op.scale_cut(&mut scaled);
-        pre.apply(&scaled, active, z);
+        self.scaled.clear();
+        self.scaled.extend_from_slice(g);
+        self.op.scale_cut(&mut self.scaled);
+        pre.apply(&self.scaled, active, z);
         self.op.scale_cut(z);
     }
 }
@@ -517,6 +521,7 @@ pub fn solve_normal(
     let mut fine_op = Fine {
         op: &mut *op,
         precond: &mut cache.precond,
+        scaled: Vec::new(),
     };
     let report = polonsky_keer(&mut fine_op, &fine, &mut p, &mut u);
     // The preconditioner's work spectrum is not held between normal solves

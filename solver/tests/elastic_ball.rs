@@ -5,6 +5,7 @@
 //! symmetries of the summed kernel.
 mod common;
 
+use common::rel;
 use solver::pair_influence;
 use solver::{presets, solve_case, CaseSpec, KernelCache, Material};
 use std::f64::consts::PI;
@@ -12,10 +13,6 @@ use std::f64::consts::PI;
 const P: f64 = 20.0;
 const R: f64 = 18.0e-3;
 const MU: f64 = 0.28571;
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a / b - 1.0).abs()
-}
 
 /// `substrate` pressed by a ball of `ball` (R = 18 mm, P = 20 N) on `n`
 /// cells of `spacing_um`, F = `ratio` μP along x.
@@ -295,14 +292,7 @@ fn a_crystal_ball_mirroring_its_flat_through_the_interface_has_no_coupling() {
     // in its own frame, the substrate's stiffness mirrored in y.
     // Cu (Table 2's cubic constants) with the general normal [1 2 3]: no
     // mirror plane of the crystal contains the frame's axes.
-    let crystal = Material::cubic(
-        "Cu[123]",
-        [168.4e9, 121.4e9, 75.4e9],
-        [1.0, 2.0, 3.0],
-        [1.0, 1.0, -1.0],
-        None,
-    )
-    .unwrap();
+    let crystal = common::cu_123();
     let grid = solver::Grid::square(64, 1e-6);
     let mirror = Material::with_stiffness("mirror", mirror_y(&crystal.stiffness()), None).unwrap();
     let mirrored = pair_influence(

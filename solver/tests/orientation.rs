@@ -5,23 +5,13 @@
 //! the reference in `common::willis`, from the material's own H33(θ)).
 mod common;
 
-use solver::{solve_case, KernelCache, Material};
+use common::rel;
+use solver::{solve_case, KernelCache};
 use std::f64::consts::PI;
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a / b - 1.0).abs()
-}
 
 #[test]
 fn a_general_orientation_follows_willis_elliptical_hertz() {
-    let cu123 = Material::cubic(
-        "Cu[123]",
-        [168.4e9, 121.4e9, 75.4e9],
-        [1.0, 2.0, 3.0],
-        [1.0, 1.0, -1.0],
-        None,
-    )
-    .unwrap();
+    let cu123 = common::cu_123();
     let mut spec = common::table_1a_fe(384, 0.75, false, 0.0);
     spec.material = cu123.clone();
     let (load, radius) = (spec.load.normal_force_n, spec.load.indenter_radius_m);

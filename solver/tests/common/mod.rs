@@ -125,3 +125,21 @@ pub fn ellipse_of(p: &[f64], grid: solver::Grid) -> (f64, f64, f64) {
         angle,
     )
 }
+
+/// `|a/b − 1|`.
+pub fn rel(a: f64, b: f64) -> f64 {
+    (a / b - 1.0).abs()
+}
+
+/// Cu (Table 2's cubic constants) cut with the general normal [1 2 3], x
+/// along [1 1 −1]: no symmetry element of the crystal lies in the frame.
+pub fn cu_123() -> Material {
+    Material::cubic(
+        "Cu[123]",
+        [168.4e9, 121.4e9, 75.4e9],
+        [1.0, 2.0, 3.0],
+        [1.0, 1.0, -1.0],
+        None,
+    )
+    .unwrap()
+}
