@@ -93,6 +93,20 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         config.sweep.materials.len(),
         list(&config.sweep.materials)
     );
+    let orientations = config.orientations()?;
+    let per_crystal = orientations.len() / config.sweep.materials.len().max(1);
+    if !orientations.is_empty() {
+        let shown: Vec<String> = orientations
+            .iter()
+            .take(per_crystal)
+            .map(|o| crate::config::orientations::miller_text(o.normal))
+            .collect();
+        let _ = writeln!(
+            s,
+            "orientations: {per_crystal} per crystal, each its own kernel ({})",
+            shown.join(" ")
+        );
+    }
     let _ = writeln!(
         s,
         "surfaces:  {} ({})",
@@ -113,9 +127,14 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     }
     let _ = writeln!(
         s,
-        "cases:     {} = {} materials x {} surfaces x {} angles{ball_axis} x {levels} level(s)",
+        "cases:     {} = {} materials{} x {} surfaces x {} angles{ball_axis} x {levels} level(s)",
         cases.len(),
         config.sweep.materials.len(),
+        if orientations.is_empty() {
+            String::new()
+        } else {
+            format!(" x {per_crystal} orientations")
+        },
         config.sweep.surfaces.len(),
         angles.len()
     );

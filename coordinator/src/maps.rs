@@ -9,7 +9,7 @@ use solver::{CaseScalars, Fields};
 use std::path::Path;
 
 /// Colour of `t ∈ [0, 1]` on a perceptually ordered ramp (dark blue → yellow).
-fn ramp(t: f64) -> RGBColor {
+pub(crate) fn ramp(t: f64) -> RGBColor {
     let stops = [
         (0.0, (48, 18, 59)),
         (0.25, (40, 120, 230)),

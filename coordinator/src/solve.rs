@@ -110,7 +110,8 @@ impl CaseChoice {
         surface: Option<&str>,
         angle_deg: Option<f64>,
     ) -> Result<Self> {
-        let material = material.unwrap_or(&config.sweep.materials[0]);
+        let first = config.first_material()?;
+        let material = material.unwrap_or(&first);
         let surface = surface.unwrap_or(&config.sweep.surfaces[0]);
         let angle = Self::angle(config, angle_deg)?;
         let spec = config.spec(material, surface, angle)?;
@@ -126,7 +127,8 @@ impl CaseChoice {
         surface: Surface,
         angle_deg: Option<f64>,
     ) -> Result<Self> {
-        let material = material.unwrap_or(&config.sweep.materials[0]);
+        let first = config.first_material()?;
+        let material = material.unwrap_or(&first);
         let angle = Self::angle(config, angle_deg)?;
         let spec = config.spec_on(material, surface, angle)?;
         Self::checked(config, material, label, angle, spec)

@@ -71,6 +71,9 @@ fn accepted_keys() -> BTreeSet<String> {
     c.sweep.indenters = Some(vec!["rigid".into(), "steel".into()]);
     c.sweep.normal_loads_n = Some(vec![10.0, 20.0]);
     c.sweep.amplitudes_um = Some(vec![1.0, 2.0]);
+    c.sweep.orientations = Some(coordinator::config::OrientationsCfg::List(vec![
+        coordinator::config::orientations::OrientationCfg::Normal([1.0, 1.0, 1.0]),
+    ]));
     c.run = RunCfg {
         case_timeout_s: 5.0,
     };
@@ -167,4 +170,23 @@ fn every_example_loads_and_solves_on_a_small_grid() {
         }
     }
     assert!(solved >= 9, "{solved} cases");
+}
+
+#[test]
+fn the_orientation_map_example_expands_to_its_orientations() {
+    // configs/orientation-map.toml (issue #39): two crystals, each cut at
+    // the generated set over the standard triangle, corners first and last.
+    let c = Config::load(&root().join("configs/orientation-map.toml"), &[]).unwrap();
+    let o = c.orientations().unwrap();
+    let per = o.len() / 2;
+    assert!(per >= 8, "{per}");
+    for crystal in [&o[..per], &o[per..]] {
+        let normals: Vec<[f64; 3]> = crystal.iter().map(|o| o.normal).collect();
+        for corner in [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 1.0]] {
+            assert!(normals.contains(&corner), "{normals:?}");
+        }
+    }
+    let surfaces = c.sweep.surfaces.len();
+    let angles = c.sweep.angles_deg.values().unwrap().len();
+    assert_eq!(c.cases().unwrap().len(), o.len() * surfaces * angles);
 }

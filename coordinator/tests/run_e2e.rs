@@ -1533,3 +1533,134 @@ fn issue37_fretting_map_rows_regimes_and_transition() {
     );
     assert!(o.join("fields/Cu/flat/000.0@12um").is_dir());
 }
+
+/// Cu cut at the three corners of the standard triangle, flat (32², as
+/// [`CONFIG`]), coupled so that the anisotropic K_E calibration runs.
+const ORIENT_CONFIG: &str = r#"
+[grid]
+points = 32
+spacing_um = 200.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.6
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["flat"]
+angles_deg = [0, 90]
+orientations = [[0, 0, 1], [1, 0, 1], [1, 1, 1]]
+
+[materials.Cu]
+cubic_gpa = { c11 = 168.4, c12 = 121.4, c44 = 75.4 }
+"#;
+
+#[test]
+fn issue39_orientations_are_the_single_crystals_and_map_the_triangle() {
+    let dir = scratch("orient");
+    // The same three crystals as single materials, each with the frame the
+    // default rule gives (x = [0 1 0] × normal).
+    let mut single = ORIENT_CONFIG
+        .replace(
+            "materials = [\"Cu\"]",
+            "materials = [\"c001\", \"c101\", \"c111\"]",
+        )
+        .replace("orientations = [[0, 0, 1], [1, 0, 1], [1, 1, 1]]\n", "");
+    let table = "cubic_gpa = { c11 = 168.4, c12 = 121.4, c44 = 75.4 }";
+    single = single.replace(&format!("[materials.Cu]\n{table}\n"), "");
+    for (name, n, x) in [
+        ("c001", "[0, 0, 1]", "[1, 0, 0]"),
+        ("c101", "[1, 0, 1]", "[1, 0, -1]"),
+        ("c111", "[1, 1, 1]", "[1, 0, -1]"),
+    ] {
+        single.push_str(&format!(
+            "\n[materials.{name}]\n{table}\nnormal = {n}\nx_dir = {x}\n"
+        ));
+    }
+    for (name, text) in [("axis", ORIENT_CONFIG), ("single", single.as_str())] {
+        std::fs::write(dir.join("sweep.toml"), text).unwrap();
+        check_ok(
+            &sweep_cmd(&dir, name, 2, "o").output().unwrap(),
+            &format!("{name} sweep"),
+        );
+    }
+    // Every row but the material's name equals the single crystal's, to
+    // the bit (the same rotation builds both stiffnesses).
+    let physics = |out: &str| -> Vec<String> {
+        let rows = read_csv(&dir.join(out).join("results.csv"));
+        let h = &rows[0];
+        let keep: Vec<usize> = (1..h.len())
+            .filter(|&i| !["seconds", "worker"].contains(&h[i].as_str()))
+            .collect();
+        rows[1..]
+            .iter()
+            .map(|r| {
+                keep.iter()
+                    .map(|&i| r[i].as_str())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .collect()
+    };
+    let (axis, alone) = (physics("axis"), physics("single"));
+    assert_eq!(axis.len(), 6);
+    assert_eq!(axis, alone);
+    let ids: BTreeSet<String> = journal_cases(&dir.join("axis"))
+        .iter()
+        .map(|v| v["case_id"].as_str().unwrap().to_string())
+        .collect();
+    assert!(ids.contains("Cu[1 0 1]/flat/090.0"), "{ids:?}");
+    // The orientation table: one row per orientation, the crystal's
+    // quantities and the reductions over the two angles.
+    let t = read_csv(&dir.join("axis").join("orientations.csv"));
+    assert_eq!(t[0].join(","), coordinator::run::ORIENTATIONS_HEADER);
+    assert_eq!(t.len(), 4);
+    let col = |name: &str| t[0].iter().position(|h| h == name).unwrap();
+    let modulus: Vec<f64> = t[1..]
+        .iter()
+        .map(|r| r[col("indentation_modulus_gpa")].parse().unwrap())
+        .collect();
+    // Vlassak–Nix for Cu: (001) < (101) < (111), 13 % apart.
+    assert!(
+        modulus[0] < modulus[1] && modulus[1] < modulus[2],
+        "{modulus:?}"
+    );
+    assert!(
+        (modulus[2] / modulus[0] - 1.131).abs() < 0.002,
+        "{modulus:?}"
+    );
+    assert!(t[1..].iter().all(|r| r[col("angles")] == "2"));
+    for f in [
+        "ipf/Cu/indentation_modulus.png",
+        "ipf/Cu/indentation_modulus.svg",
+        "ipf/Cu/flat/k_e.png",
+        "ipf/Cu/flat/k_e_range.png",
+    ] {
+        let p = dir.join("axis").join(f);
+        assert!(p.metadata().is_ok_and(|m| m.len() > 1000), "{f}");
+    }
+    // μa on the flat surface is μ by the calibration: no map of a constant.
+    assert!(!dir.join("axis/ipf/Cu/flat/mu_a.png").exists());
+    // `check` counts the orientations and their kernels.
+    std::fs::write(dir.join("sweep.toml"), ORIENT_CONFIG).unwrap();
+    let check = Command::new(EXE)
+        .arg("check")
+        .arg(dir.join("sweep.toml"))
+        .output()
+        .unwrap();
+    check_ok(&check, "check");
+    let text = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        text.contains("cases:     6 = 1 materials x 3 orientations x 1 surfaces x 2 angles"),
+        "{text}"
+    );
+    assert!(
+        text.contains("kernels:   3 (") && text.contains("Cu[1 1 1] at 32²"),
+        "{text}"
+    );
+    assert!(shm_leftovers("o").is_empty());
+}

@@ -185,17 +185,38 @@ class RunResult:
     ``fretting_map`` and ``fretting_transitions``: ``fretting_map.csv`` and
     ``fretting_transitions.csv`` the same way in a sweep with
     ``sweep.amplitudes_um`` (a fretting map), ``None`` otherwise.
+    ``orientations``: ``orientations.csv`` the same way in a sweep with
+    ``sweep.orientations`` (the numbers behind the inverse-pole-figure maps
+    under ``out / "ipf"``), ``None`` otherwise.
     """
 
-    __slots__ = ("results", "curves", "summary", "out", "fretting_map", "fretting_transitions")
+    __slots__ = (
+        "results",
+        "curves",
+        "summary",
+        "out",
+        "fretting_map",
+        "fretting_transitions",
+        "orientations",
+    )
 
-    def __init__(self, results, curves, summary, out, fretting_map=None, fretting_transitions=None):
+    def __init__(
+        self,
+        results,
+        curves,
+        summary,
+        out,
+        fretting_map=None,
+        fretting_transitions=None,
+        orientations=None,
+    ):
         self.results = results
         self.curves = curves
         self.summary = summary
         self.out = out
         self.fretting_map = fretting_map
         self.fretting_transitions = fretting_transitions
+        self.orientations = orientations
 
     def __repr__(self):
         s = self.summary
@@ -237,6 +258,7 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
         out=out,
         fretting_map=_read_csv_if(out / "fretting_map.csv"),
         fretting_transitions=_read_csv_if(out / "fretting_transitions.csv"),
+        orientations=_read_csv_if(out / "orientations.csv"),
     )
 
 

@@ -153,3 +153,32 @@ def test_a_fretting_map_returns_its_table(tmp_path):
     t = res.fretting_transitions["transition_um"]
     assert 3.0 < t[0] < 12.0
     assert (res.out / "fretting_map.png").exists()
+
+
+def test_an_orientation_sweep_returns_its_table(tmp_path):
+    # sweep.orientations (issue #39): run() reads orientations.csv, and a
+    # crystal cut at an orientation solves by its name as a single case.
+    cfg = mpcontact.Config.from_dict(
+        {
+            "grid": {"points": 32, "spacing_um": 200.0},
+            "indenter": {"radius_mm": 200.0},
+            "load": {"normal_n": 6000.0, "friction": 0.3, "tangential_ratio": 0.6},
+            "sweep": {
+                "materials": ["Cu"],
+                "angles_deg": [0, 90],
+                "orientations": [[0, 0, 1], [1, 1, 1]],
+            },
+            "materials": {"Cu": {"cubic_gpa": {"c11": 168.4, "c12": 121.4, "c44": 75.4}}},
+        }
+    )
+    res = mpcontact.run(cfg, workers=2, out=tmp_path / "orient", progress=False)
+    t = res.orientations
+    assert list(t["orientation"]) == ["[0 0 1]", "[1 1 1]"]
+    m = t["indentation_modulus_gpa"]
+    assert 1.12 < m[1] / m[0] < 1.14
+    assert (res.out / "ipf" / "Cu" / "indentation_modulus.png").exists()
+    r = res.results
+    for name, a, dz in zip(r["material"], r["angle_deg"], r["delta_z_m"]):
+        s = mpcontact.solve(cfg, material=str(name), angle_deg=a).scalars
+        assert s["delta_z_m"] == dz
+    assert set(r["material"]) == {"Cu[0 0 1]", "Cu[1 1 1]"}

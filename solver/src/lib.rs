@@ -71,6 +71,7 @@ mod fista;
 pub mod geometry;
 mod grid;
 mod history;
+pub mod indentation;
 #[doc(hidden)]
 pub mod influence;
 mod kernels;

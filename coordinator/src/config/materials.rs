@@ -2,6 +2,7 @@
 //! cubic constants with an orientation), how a name resolves (tables first,
 //! then presets) and the config keys of a material's solver parameters.
 
+use super::orientations::Orientation;
 use super::{within, Config, RIGID};
 use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
@@ -60,10 +61,98 @@ pub(super) fn material_key<'a>(param: &'a str, cfg: Option<&MaterialCfg>) -> &'a
     }
 }
 
+/// One material of the sweep: its name in case ids and outputs, the
+/// material, and the orientation it was cut at (`sweep.orientations`).
+#[derive(Clone, Debug)]
+pub struct SweepMaterial {
+    /// Name in ids and outputs (`Cu`, or `Cu[1 2 3]` for an orientation).
+    pub name: String,
+    /// The material.
+    pub material: Material,
+    /// The orientation of a crystal cut by `sweep.orientations`.
+    pub orientation: Option<Orientation>,
+}
+
 impl Config {
-    /// Resolves a material name: `[materials.NAME]` first, then presets.
+    /// Resolves a material name: an orientation of `sweep.orientations`
+    /// (`Cu[1 2 3]`), `[materials.NAME]`, then presets.
     pub fn material(&self, name: &str) -> Result<Material> {
+        if self.sweep.orientations.is_some() && !self.materials.contains_key(name) {
+            if let Some(m) = self.sweep_materials()?.into_iter().find(|m| m.name == name) {
+                return Ok(m.material);
+            }
+        }
         self.material_for("sweep.materials", name)
+    }
+
+    /// The sweep's materials in order: each of `sweep.materials`, or with
+    /// `sweep.orientations` each crystal once per orientation. Errors name
+    /// the key.
+    pub fn sweep_materials(&self) -> Result<Vec<SweepMaterial>> {
+        let Some(orientations) = &self.sweep.orientations else {
+            return self
+                .sweep
+                .materials
+                .iter()
+                .map(|m| {
+                    Ok(SweepMaterial {
+                        name: m.clone(),
+                        material: self.material(m)?,
+                        orientation: None,
+                    })
+                })
+                .collect();
+        };
+        let mut out = Vec::new();
+        for base in &self.sweep.materials {
+            let cfg = self
+                .materials
+                .get(base)
+                .filter(|c| c.cubic_gpa.is_some())
+                .ok_or_else(|| {
+                    anyhow!("sweep.orientations: `{base}` is not a cubic crystal; orientations cut `[materials.NAME]` tables with `cubic_gpa` (and without `normal`/`x_dir`, which the orientations give)")
+                })?;
+            if cfg.normal.is_some() || cfg.x_dir.is_some() {
+                bail!("materials.{base}.normal: sweep.orientations gives the orientations of `{base}`; leave `normal` and `x_dir` out of its table");
+            }
+            for o in super::orientations::expand(base, orientations)? {
+                let explain = |e| {
+                    anyhow!(
+                        "sweep.orientations: {} of `{base}`: {e}",
+                        super::orientations::miller_text(o.normal)
+                    )
+                };
+                let material = cubic(&o.name, cfg, o.normal, o.x_dir, &explain)?;
+                out.push(SweepMaterial {
+                    name: o.name.clone(),
+                    material,
+                    orientation: Some(o),
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// The name of the sweep's first material (a single case's default):
+    /// the first of `sweep.materials`, at its first orientation with
+    /// `sweep.orientations`.
+    pub fn first_material(&self) -> Result<String> {
+        if self.sweep.orientations.is_none() {
+            return Ok(self.sweep.materials[0].clone());
+        }
+        Ok(self.sweep_materials()?.swap_remove(0).name)
+    }
+
+    /// The orientations of `sweep.orientations` (empty without the key).
+    pub fn orientations(&self) -> Result<Vec<Orientation>> {
+        if self.sweep.orientations.is_none() {
+            return Ok(Vec::new());
+        }
+        Ok(self
+            .sweep_materials()?
+            .into_iter()
+            .filter_map(|m| m.orientation)
+            .collect())
     }
 
     /// The ball's material (`indenter.material`), `None` for a rigid ball.
@@ -155,12 +244,7 @@ fn build_material(
         }
         return Material::isotropic(name, iso.youngs_gpa * 1e9, iso.poisson).map_err(explain);
     }
-    // The isotropic-equivalent constants only normalise (the paper's Cu(111)
-    // has ν = 0.503): taken as given; the material checks them.
-    let equivalent = m.equivalent.map(|e| Isotropic {
-        youngs: e.youngs_gpa * 1e9,
-        poisson: e.poisson,
-    });
+    let equivalent = equivalent_of(m);
     if let Some(rows) = &m.stiffness_gpa {
         if rows.len() != 6 || rows.iter().any(|r| r.len() != 6) {
             bail!(
@@ -171,13 +255,38 @@ fn build_material(
         let c = nalgebra::Matrix6::from_fn(|i, j| rows[i][j] * 1e9);
         return Material::with_stiffness(name, c, equivalent).map_err(explain);
     }
-    let cub = m.cubic_gpa.expect("counted above");
-    let normal = m
-        .normal
-        .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("normal")))?;
+    let normal = m.normal.ok_or_else(|| {
+        anyhow!(
+            "{}: required with cubic_gpa (or list the crystal's orientations in sweep.orientations)",
+            key("normal")
+        )
+    })?;
     let x_dir = m
         .x_dir
         .ok_or_else(|| anyhow!("{}: required with cubic_gpa", key("x_dir")))?;
+    cubic(name, m, normal, x_dir, explain)
+}
+
+/// The isotropic-equivalent constants of table `m`. They only normalise
+/// (the paper's Cu(111) has ν = 0.503): taken as given; the material
+/// checks them.
+fn equivalent_of(m: &MaterialCfg) -> Option<Isotropic> {
+    m.equivalent.map(|e| Isotropic {
+        youngs: e.youngs_gpa * 1e9,
+        poisson: e.poisson,
+    })
+}
+
+/// The cubic crystal of table `m` cut with `normal` and `x_dir`.
+fn cubic(
+    name: &str,
+    m: &MaterialCfg,
+    normal: [f64; 3],
+    x_dir: [f64; 3],
+    explain: &dyn Fn(SolverError) -> anyhow::Error,
+) -> Result<Material> {
+    let cub = m.cubic_gpa.expect("a cubic table");
+    let equivalent = equivalent_of(m);
     let constants = [cub.c11 * 1e9, cub.c12 * 1e9, cub.c44 * 1e9];
     Material::cubic(name, constants, normal, x_dir, equivalent).map_err(explain)
 }

@@ -14,6 +14,7 @@ mod convergence;
 mod grid;
 mod history;
 mod materials;
+pub mod orientations;
 mod solving;
 mod stress;
 mod surfaces;
@@ -23,7 +24,8 @@ mod toml_text;
 pub use convergence::{ladder_points, ConvergenceCfg, MAX_LEVELS};
 pub use grid::{GridCfg, IndenterCfg, LoadCfg};
 pub use history::{FrettingCfg, HistoryCfg, MAX_CYCLES};
-pub use materials::{CubicCfg, IsoCfg, MaterialCfg};
+pub use materials::{CubicCfg, IsoCfg, MaterialCfg, SweepMaterial};
+pub use orientations::{Orientation, OrientationsCfg};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};
 pub use stress::StressCfg;
 pub use surfaces::{heightmap_surface, SurfaceCfg};
@@ -332,8 +334,11 @@ impl Config {
             }
         }
         let mut out = Vec::new();
-        for m in &self.sweep.materials {
-            let material = self.material(m)?;
+        for SweepMaterial {
+            name: m, material, ..
+        } in self.sweep_materials()?
+        {
+            let m = &m;
             for (s, surface) in &surfaces {
                 for &a in &angles {
                     for &((name, ball), p, d) in &points {

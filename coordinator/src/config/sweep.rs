@@ -155,6 +155,12 @@ pub struct SweepCfg {
     /// amplitude axis. Not written back when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub amplitudes_um: Option<Vec<f64>>,
+    /// Crystal orientations (`sweep.orientations`): every material of the
+    /// sweep, a cubic `[materials.*]` table, cut once per orientation.
+    /// Absent: each material as its table gives it. Not written back when
+    /// absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientations: Option<super::orientations::OrientationsCfg>,
 }
 
 /// The name that means "no ball" in `sweep.indenters`.

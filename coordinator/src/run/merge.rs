@@ -192,6 +192,14 @@ pub fn merge_shards(dirs: &[PathBuf], out_dir: &Path) -> anyhow::Result<RunSumma
         ..Default::default()
     };
     summary.tally(&plan.cases, &outcomes);
-    super::write_outputs(out_dir, &plan.cases, &outcomes, &mut summary, &first.config)?;
+    let orientations = config.orientations()?;
+    super::write_outputs(
+        out_dir,
+        &plan.cases,
+        &outcomes,
+        &mut summary,
+        &first.config,
+        &orientations,
+    )?;
     Ok(summary)
 }

@@ -15,6 +15,7 @@ mod fretting_map;
 mod journal;
 mod lock;
 mod merge;
+mod orientation_map;
 mod output;
 mod plan;
 mod progress;
@@ -32,6 +33,7 @@ pub use exchange::Interrupted;
 pub use fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
+pub use orientation_map::ORIENTATIONS_HEADER;
 pub use output::{CURVES_HEADER, RESULTS_HEADER};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
@@ -176,7 +178,15 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     summary.cases_per_minute = solved_now as f64 / (summary.wall_seconds / 60.0).max(1e-9);
 
     let (cases, outcomes) = recorder.results();
-    write_outputs(&args.out_dir, cases, outcomes, &mut summary, &raw)?;
+    let orientations = args.config.orientations()?;
+    write_outputs(
+        &args.out_dir,
+        cases,
+        outcomes,
+        &mut summary,
+        &raw,
+        &orientations,
+    )?;
     if !args.quiet {
         eprintln!(
             "{} cases: {} ok, {} not converged, {} failed ({} resumed) in {:.1} s → {}",
@@ -231,6 +241,7 @@ fn write_outputs(
     outcomes: &[Option<Outcome>],
     summary: &mut RunSummary,
     raw_config: &str,
+    orientations: &[crate::config::Orientation],
 ) -> anyhow::Result<()> {
     let rows = output::calibrate(cases, outcomes);
     let write = |name: &str, text: String| crate::atomic::write(&dir.join(name), text.as_bytes());
@@ -290,6 +301,21 @@ fn write_outputs(
         for name in ["fretting_map.png", "fretting_map.svg"] {
             if let Err(e) = fretting_map::plot_map(&dir.join(name), &map) {
                 summary.output_warnings.push(format!("{name}: {e:#}"));
+            }
+        }
+    }
+    // Orientation maps (sweep.orientations): their table and the IPF maps.
+    if !orientations.is_empty() {
+        let table = orientation_map::orientation_rows(&rows, &points, orientations);
+        write(
+            "orientations.csv",
+            orientation_map::orientations_csv(&table),
+        )?;
+        for map in orientation_map::ipf_maps(&table) {
+            if let Err(e) = orientation_map::write_ipf(&dir.join("ipf"), &map) {
+                summary
+                    .output_warnings
+                    .push(format!("ipf/{}: {e:#}", map.path.display()));
             }
         }
     }

@@ -39,14 +39,14 @@ pub const AMPLITUDE_COLUMN: &str = "amplitude_um";
 /// Which identity axes beyond material × surface × angle a sweep has (each
 /// adds a column after `surface`).
 #[derive(Clone, Copy, Debug, Default)]
-struct Axes {
-    balls: bool,
-    loads: bool,
-    amplitudes: bool,
+pub(super) struct Axes {
+    pub(super) balls: bool,
+    pub(super) loads: bool,
+    pub(super) amplitudes: bool,
 }
 
 impl Axes {
-    fn of<'a>(keys: impl Iterator<Item = &'a CaseKey>) -> Self {
+    pub(super) fn of<'a>(keys: impl Iterator<Item = &'a CaseKey>) -> Self {
         let mut a = Axes::default();
         for k in keys {
             a.balls |= k.indenter.is_some();
@@ -186,7 +186,7 @@ pub fn results_csv(rows: &[Row]) -> String {
     out
 }
 
-fn csv_field(s: &str) -> String {
+pub(super) fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
