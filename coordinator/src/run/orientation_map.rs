@@ -377,6 +377,56 @@ fn unit_of(x: f64, y: f64) -> Vector3<f64> {
     Vector3::new(2.0 * x, 2.0 * y, 1.0 - s) / (1.0 + s)
 }
 
+/// A computed orientation in the projected plane, for the triangulation.
+struct Site {
+    at: spade::Point2<f64>,
+    value: f64,
+}
+
+impl spade::HasPosition for Site {
+    type Scalar = f64;
+    fn position(&self) -> spade::Point2<f64> {
+        self.at
+    }
+}
+
+/// The map's interpolant: Sibson's natural-neighbour interpolation on the
+/// Delaunay triangulation of the projected orientations — a convex
+/// combination of the neighbours' values (no overshoot, exact at each
+/// orientation), smooth between them — and, outside their convex hull
+/// (the sliver between the curved (101)–(111) edge and its chords, or a
+/// short list of normals), Shepard's inverse-distance weighting.
+struct Interpolant<'a> {
+    dt: spade::DelaunayTriangulation<Site>,
+    pts: &'a [(Vector3<f64>, f64)],
+}
+
+impl<'a> Interpolant<'a> {
+    fn new(pts: &'a [(Vector3<f64>, f64)]) -> Self {
+        use spade::Triangulation as _;
+        let mut dt = spade::DelaunayTriangulation::<Site>::new();
+        for (v, value) in pts {
+            let at = spade::Point2::new(v.x / (1.0 + v.z), v.y / (1.0 + v.z));
+            // A repeated point (an equivalent normal) keeps the first value;
+            // a point spade cannot take (not finite) is left to Shepard.
+            let _ = dt.insert(Site { at, value: *value });
+        }
+        Interpolant { dt, pts }
+    }
+
+    fn at(&self, x: f64, y: f64) -> f64 {
+        use spade::Triangulation as _;
+        let inside = if self.dt.num_vertices() >= 3 {
+            self.dt
+                .natural_neighbor()
+                .interpolate(|v| v.data().value, spade::Point2::new(x, y))
+        } else {
+            None
+        };
+        inside.unwrap_or_else(|| interpolate(&unit_of(x, y), self.pts))
+    }
+}
+
 /// The value at the unit direction `v` between the orientations `pts`
 /// (unit normals reduced to the triangle): Shepard's inverse-distance
 /// weighting on the angle, power 2 — exact at each computed orientation,
@@ -456,6 +506,7 @@ where
     let cols = 110;
     let h = (xmax + 0.0) / cols as f64;
     let rows = (ymax / h).ceil() as usize + 1;
+    let field = Interpolant::new(&pts);
     let mut cells = Vec::new();
     for j in 0..rows {
         for i in 0..=cols {
@@ -464,7 +515,7 @@ where
             if v.y < 0.0 || v.x < v.y || v.z < v.x {
                 continue;
             }
-            let t = (interpolate(&v, &pts) - lo) / (hi - lo);
+            let t = (field.at(x, y) - lo) / (hi - lo);
             cells.push(Rectangle::new(
                 [(x - 0.5 * h, y - 0.5 * h), (x + 0.5 * h, y + 0.5 * h)],
                 crate::maps::ramp(t).filled(),
@@ -561,6 +612,35 @@ mod tests {
         let mid = Vector3::new(1.0, 0.5, 2.0).normalize();
         let m = interpolate(&mid, &pts);
         assert!(m > 1.0 && m < 3.0, "{m}");
+        // Natural neighbours: exact at the sites, inside their range, and
+        // linear data reproduced inside the hull (Sibson's coordinates
+        // reproduce linear functions).
+        let f = |x: f64, y: f64| 2.0 + 3.0 * x - 5.0 * y;
+        let sites: Vec<(Vector3<f64>, f64)> = [
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [1.0, 0.0, 3.0],
+            [2.0, 1.0, 3.0],
+            [1.0, 1.0, 3.0],
+        ]
+        .iter()
+        .map(|n| {
+            let u = Vector3::from(*n).normalize();
+            (u, f(u.x / (1.0 + u.z), u.y / (1.0 + u.z)))
+        })
+        .collect();
+        let field = Interpolant::new(&sites);
+        for (u, v) in &sites {
+            let (x, y) = (u.x / (1.0 + u.z), u.y / (1.0 + u.z));
+            assert!((field.at(x, y) - v).abs() < 1e-12);
+        }
+        let (x, y) = (0.2, 0.05);
+        assert!(
+            (field.at(x, y) - f(x, y)).abs() < 1e-12,
+            "{}",
+            field.at(x, y)
+        );
         // The projection inverts.
         let (x, y) = ipf_xy([1.0, 2.0, 3.0]);
         let v = unit_of(x, y);
