@@ -21,7 +21,7 @@ use crate::float_text::fmt_f64;
 
 /// Header of `orientations.csv` (`indenter`, `normal_n`, `amplitude_um`
 /// after `surface` as in the other CSVs of a sweep with those axes).
-pub const ORIENTATIONS_HEADER: &str = "material,orientation,x_dir,ipf_x,ipf_y,surface,indentation_modulus_gpa,compliance_ratio,contact_long_m,contact_short_m,contact_angle_deg,contact_p_max_pa,angles,mu_a_mean,mu_a_min,mu_a_max,mu_a_err_max,k_e_mean,k_e_min,k_e_max,dissipated_j_mean,dissipated_j_min,dissipated_j_max";
+pub const ORIENTATIONS_HEADER: &str = "material,orientation,x_dir,ipf_x,ipf_y,surface,indentation_modulus_gpa,compliance_ratio,contact_long_m,contact_short_m,contact_angle_deg,contact_p_max_pa,angles,mu_a_mean,mu_a_min,mu_a_max,mu_a_err_max,k_e_mean,k_e_min,k_e_max,dissipated_j_mean,dissipated_j_min,dissipated_j_max,dissipated_j_err_max";
 
 /// One orientation on one surface (× ball × load × amplitude).
 #[derive(Clone, Debug)]
@@ -46,6 +46,8 @@ pub struct OrientationRow {
     pub k_e: Option<(f64, f64, f64)>,
     /// (mean, min, max) of the energy per cycle over the angles, J.
     pub dissipated: Option<(f64, f64, f64)>,
+    /// Largest error bar of the energy per cycle over the angles, J.
+    pub dissipated_err: Option<f64>,
 }
 
 fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
@@ -114,6 +116,7 @@ pub fn orientation_rows(
             mu_a_err: None,
             k_e: None,
             dissipated: None,
+            dissipated_err: None,
         });
     }
     // The curve points' reductions over the angles.
@@ -130,10 +133,15 @@ pub fn orientation_rows(
         row.angles = ps.len();
         let mu: Vec<f64> = ps.iter().map(|p| p.mu_a.value).collect();
         row.mu_a = stats(&mu);
-        row.mu_a_err = ps
-            .iter()
-            .filter_map(|p| p.mu_a.err)
-            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        let largest = |errs: &mut dyn Iterator<Item = f64>| {
+            errs.fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))))
+        };
+        row.mu_a_err = largest(&mut ps.iter().filter_map(|p| p.mu_a.err));
+        row.dissipated_err = largest(
+            &mut ps
+                .iter()
+                .filter_map(|p| p.dissipated.as_ref().and_then(|d| d.err)),
+        );
         let ke: Vec<f64> = ps.iter().map(|p| p.k_e.value).collect();
         row.k_e = stats(&ke);
         let w: Vec<f64> = ps
@@ -191,7 +199,7 @@ pub fn orientations_csv(rows: &[OrientationRow]) -> String {
         let c = &r.contact;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             csv_field(&o.base),
             csv_field(&miller_text(o.normal)),
             csv_field(&miller_text(o.x_dir)),
@@ -214,6 +222,7 @@ pub fn orientations_csv(rows: &[OrientationRow]) -> String {
             opt(r.mu_a_err),
             triple(r.k_e),
             triple(r.dissipated),
+            opt(r.dissipated_err),
         );
     }
     out
@@ -287,8 +296,6 @@ pub fn ipf_maps(rows: &[OrientationRow]) -> Vec<IpfMap> {
             });
         }
         let r0 = rs[0];
-        let mut place = r0.key.clone();
-        place.material = String::new();
         let surface_dir = dir.join(safe(
             &format!("{}{}", r0.key.surface, ball_and_axes(&r0.key)).replace('/', "_"),
         ));
