@@ -209,7 +209,7 @@ fn worker_count(workers: Option<usize>) -> Result<usize> {
 /// The dry-run report, headed by the config's path.
 fn check_report(path: &std::path::Path, config: &Config, workers: usize) -> Result<String> {
     let stress = if config.stress.is_some() {
-        "stress:    [stress] is computed by `mpcontact solve` and Python, not by sweeps: `run` refuses this config\n"
+        "stress:    [stress]: every case's workers also compute the stresses below the surface (one kernel per depth plane and slice row, and the surface plane)\n"
     } else {
         ""
     };
