@@ -531,7 +531,8 @@ struct Panel {
 /// material, one series per surface with markers at the computed angles
 /// and error bars where a ladder gave them, the flat surface in black; and,
 /// when a material's K_E was calibrated on its flat surface, a panel of
-/// K_E(ψ) (GPa) for those materials. The legend sits beside the panels.
+/// K_E(ψ) (GPa) for those materials; with `[stress]`, a panel per material
+/// of the largest von Mises stress over p_H. The legend sits beside the panels.
 pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
     let mut k_e = Panel {
@@ -584,8 +585,31 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
                 .insert(surface, e);
         }
     }
+    // With [stress]: the largest von Mises stress over p_H, per material.
+    let mut stress: BTreeMap<&str, Panel> = BTreeMap::new();
+    for ((material, surface), pts) in by_curve(points) {
+        let vm: Vec<(f64, f64, Option<f64>)> = pts
+            .iter()
+            .filter_map(|p| {
+                let l = p.stress.as_ref()?.worst(|st| Some(st.max_von_mises))?;
+                Some((p.key.angle_deg, l.over_p_h, None))
+            })
+            .collect();
+        if !vm.is_empty() {
+            stress
+                .entry(material)
+                .or_insert_with(|| Panel {
+                    title: format!("{material}: largest von Mises stress"),
+                    y_desc: "max von Mises / p_H (–)",
+                    series: BTreeMap::new(),
+                })
+                .series
+                .insert(surface, vm);
+        }
+    }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     panels.extend(energy.into_values());
+    panels.extend(stress.into_values());
     if !k_e.series.is_empty() {
         panels.push(k_e);
     }
