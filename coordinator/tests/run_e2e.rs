@@ -1697,3 +1697,68 @@ fn issue38_a_sweep_computes_the_stresses_of_solve_and_only_with_the_section() {
     let journal = std::fs::read_to_string(without.join("journal.jsonl")).unwrap();
     assert!(!journal.contains("\"stress\""));
 }
+
+/// A fretting path in a sweep with `[stress]`: the turning states' scalars
+/// (three states, Crossland, SWT over the cycle) equal `solve`'s to the
+/// bit; their arrays are not written by the sweep (the turning states'
+/// tractions do not travel back) and the run says so; a resumed sweep
+/// rewrites the same results.csv from its journal.
+#[test]
+fn issue38_a_fretting_sweep_keeps_the_turning_states_scalars_and_resumes() {
+    let d = scratch("stress-history");
+    let config = STRESS_SWEEP.replace("angles_deg = [0.0, 45.0]", "angles_deg = [0.0]")
+        + "\n[history]\ntangential_ratios = [0.0, 0.5, -0.5]\nsteps_per_segment = 2\n"
+        + "\n[stress]\ndepths_um = [0.0]\nslice_rows = 4\n";
+    std::fs::write(d.join("sweep.toml"), config).unwrap();
+    let mut cmd = sweep_cmd(&d, "o", 1, "sh");
+    cmd.arg("--save-fields");
+    let out = cmd.output().unwrap();
+    check_ok(&out, "fretting sweep with [stress]");
+    let o = d.join("o");
+    let fields = o.join("fields/Cu/flat/000.0");
+    assert!(fields.join("p.npy").is_file());
+    assert!(!fields.join("stress").exists(), "no turning-state arrays");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("turning states are not written"));
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fields.join("stress.json")).unwrap())
+            .unwrap();
+    let solved = d.join("solve");
+    check_ok(
+        &Command::new(EXE)
+            .arg("solve")
+            .arg(d.join("sweep.toml"))
+            .args(["--quiet", "--out"])
+            .arg(&solved)
+            .output()
+            .unwrap(),
+        "solve",
+    );
+    let case: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(solved.join("case.json")).unwrap()).unwrap();
+    assert_eq!(written, case["stress"]);
+    assert_eq!(written["states"].as_array().unwrap().len(), 3);
+    let rows = read_csv(&o.join("results.csv"));
+    let col = |name: &str| rows[0].iter().position(|h| h == name).unwrap();
+    let bits = |cell: &str| cell.parse::<f64>().unwrap().to_bits();
+    let cl = written["crossland"]["value_pa"].as_f64().unwrap();
+    assert_eq!(bits(&rows[1][col("crossland_pa")]), cl.to_bits());
+    let swt = written["swt"]["value_pa"].as_f64().unwrap();
+    assert_eq!(bits(&rows[1][col("swt_pa")]), swt.to_bits());
+    // The worst state's von Mises is the CSV's.
+    let vm = written["states"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["max_von_mises"]["value_pa"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(bits(&rows[1][col("max_von_mises_pa")]), vm.to_bits());
+    // Resume: nothing recomputed, the same table from the journal.
+    let before = std::fs::read_to_string(o.join("results.csv")).unwrap();
+    let mut again = sweep_cmd(&d, "o", 1, "sr");
+    again.arg("--resume");
+    check_ok(&again.output().unwrap(), "resume");
+    assert_eq!(
+        std::fs::read_to_string(o.join("results.csv")).unwrap(),
+        before
+    );
+}
