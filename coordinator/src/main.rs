@@ -208,13 +208,8 @@ fn worker_count(workers: Option<usize>) -> Result<usize> {
 
 /// The dry-run report, headed by the config's path.
 fn check_report(path: &std::path::Path, config: &Config, workers: usize) -> Result<String> {
-    let stress = if config.stress.is_some() {
-        "stress:    [stress]: every case's workers also compute the stresses below the surface (one kernel per depth plane and slice row, and the surface plane)\n"
-    } else {
-        ""
-    };
     Ok(format!(
-        "config:    {} (valid)\n{stress}{}nothing was solved or written (dry run)\n",
+        "config:    {} (valid)\n{}nothing was solved or written (dry run)\n",
         path.display(),
         coordinator::dry_run::report(config, workers)?
     ))

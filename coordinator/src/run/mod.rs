@@ -110,9 +110,14 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     }
     let plan = Plan::new(cases);
     let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
+    let n = args.config.finest_points();
+    let stress_bytes = args.config.stress.as_ref().map_or(0.0, |cfg| {
+        let states = crate::memory::stress_states(cfg, plan.cases.iter().map(|c| &c.spec));
+        crate::memory::stress_bytes(n, cfg, states)
+    });
     crate::memory::check_fits(
         "the sweep",
-        crate::memory::worker_bytes(args.config.finest_points(), kernels.len()),
+        crate::memory::worker_bytes(n, kernels.len()) + stress_bytes,
         args.workers,
         crate::memory::available_bytes(),
     )?;
