@@ -534,8 +534,8 @@ fn a_load_history_keeps_the_tractions_of_its_turning_points() {
 /// shear traction on the surface away from the force, and carries the
 /// force through every plane (`∫σxz dA = −1`, a closed-form integral);
 /// its quadrature over the Hertz traction is converged (rules of 16 and
-/// 24 points agree), and far away the traction acts as its resultant
-/// `2π/3` at the centre.
+/// 24 points agree), far away the traction acts as its resultant `2π/3`
+/// at the centre, and at the trailing edge it gives Hamilton's tension.
 #[test]
 fn cerruti_reference_is_an_elastic_field_and_its_quadrature_converged() {
     let nu = 0.3;
@@ -645,6 +645,18 @@ fn cerruti_reference_is_an_elastic_field_and_its_quadrature_converged() {
     println!("sliding quadrature: rules 16 vs 24 differ by {worst_rule:.1e} (units of f p0); far field σxz vs the resultant at the centre {far_rel:.1e}");
     assert!(worst_rule < 1e-6);
     assert!(far_rel < 0.02);
+    // Hamilton's trailing-edge tension of the tangential part, π(4 + ν)/8
+    // (per unit f p0) at (−a, 0, 0): the field has a square-root edge, so
+    // σxx(z) → σ0 + c√z; Richardson with that order from z = 1e-6, 2e-6.
+    let (a, b) = (
+        sliding_tangential(-1.0, 0.0, 1e-6, nu, 16)[0],
+        sliding_tangential(-1.0, 0.0, 2e-6, nu, 16)[0],
+    );
+    let r = 2f64.sqrt();
+    let edge = (r * a - b) / (r - 1.0);
+    let hamilton = trailing_edge_sxx(nu, 1.0) - trailing_edge_sxx(nu, 0.0);
+    println!("trailing edge, tangential part: {edge:.8} (Hamilton π(4 + ν)/8 = {hamilton:.8})");
+    assert!((edge - hamilton).abs() < 1e-5);
 }
 
 /// Worst |computed − reference| / p0 over the six components for the
