@@ -43,8 +43,61 @@ pub fn case_seconds(spec: &CaseSpec) -> f64 {
     }
 }
 
+/// Depth kernels `[stress]` builds for each case: one per plane, one per
+/// slice row, and the surface plane for Smith–Watson–Topper unless a plane
+/// is at 0.
+pub fn stress_kernels(cfg: &crate::config::StressCfg) -> usize {
+    let surface = usize::from(!cfg.depths_um.contains(&0.0));
+    cfg.depths_um.len() + if cfg.slices { cfg.slice_rows } else { 0 } + surface
+}
+
+/// Expected seconds of `[stress]` in one case: its depth kernels at 0.54 s
+/// each at 256² for an isotropic substrate (Fe, Table 1(a), 27 kernels:
+/// `solve --threads 1` 15.8 s with the section, 1.15 s without), 1.3 times
+/// that for a crystal (Fe(111) against Fe in the same sweep), growing like
+/// N² (the padded grid's spectra; the transforms' log N aside).
+pub fn stress_seconds(spec: &CaseSpec, cfg: &crate::config::StressCfg) -> f64 {
+    let per = 0.54 * (spec.grid.n as f64 / 256.0).powi(2);
+    let per = if spec.material.is_isotropic() {
+        per
+    } else {
+        1.3 * per
+    };
+    per * stress_kernels(cfg) as f64
+}
+
 /// Expected seconds to build one kernel on an `n x n` grid: 0.35 s at 384²
 /// (isotropic and (111) alike), growing like N².
 pub fn kernel_seconds(n: usize) -> f64 {
     0.35 * (n as f64 / 384.0).powi(2)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+
+    const BASE: &str = "[grid]\npoints = 256\nspacing_um = 1.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.3\n[sweep]\nmaterials = [\"Fe\"]\n";
+
+    /// The kernels `[stress]` builds, counted by hand: Table 1(a)'s section
+    /// (one plane at 50 µm, 25 slice rows) needs the surface too, 27; a
+    /// plane at 0 serves SWT; no slices, no rows.
+    #[test]
+    fn issue38_stress_kernels_are_planes_rows_and_the_surface() {
+        let count = |section: &str| {
+            let c = Config::parse(&format!("{BASE}[stress]\n{section}\n"), &[]).unwrap();
+            super::stress_kernels(c.stress.as_ref().unwrap())
+        };
+        assert_eq!(count("depths_um = [50.0]\nslice_rows = 25"), 27);
+        assert_eq!(count("depths_um = [0.0, 20.0]\nslices = false"), 2);
+        assert_eq!(count("depths_um = [20.0]\nslices = false"), 2);
+        // The measured case: 27 kernels at 256², 15.8 − 1.15 s.
+        let c = Config::parse(
+            &format!("{BASE}[stress]\ndepths_um = [50.0]\nslice_rows = 25\n"),
+            &[],
+        )
+        .unwrap();
+        let (_, spec) = &c.cases().unwrap()[0];
+        let t = super::stress_seconds(spec, c.stress.as_ref().unwrap());
+        assert!((t / (15.8 - 1.15) - 1.0).abs() < 0.05, "{t}");
+    }
 }

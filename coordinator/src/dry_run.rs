@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::config::Config;
-use crate::cost::{case_seconds, kernel_seconds, CASE_EXPONENT};
+use crate::cost::{case_seconds, kernel_seconds, stress_kernels, stress_seconds, CASE_EXPONENT};
 use solver::KernelKey;
 
 fn human_seconds(s: f64) -> String {
@@ -47,7 +47,11 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
             slot.insert((bodies, persistent, cached, spec.grid.n));
         }
     }
-    let per_worker = crate::memory::worker_bytes(n, kernels.len());
+    let stress_bytes = config.stress.as_ref().map_or(0.0, |cfg| {
+        let states = crate::memory::stress_states(cfg, cases.iter().map(|(_, s)| s));
+        crate::memory::stress_bytes(n, cfg, states)
+    });
+    let per_worker = crate::memory::worker_bytes(n, kernels.len()) + stress_bytes;
     crate::memory::check_fits(
         &format!("the sweep (finest grid {0} x {0} cells)", n),
         per_worker,
@@ -156,10 +160,35 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     let workers_used = workers.min(cases.len()).max(1);
     let _ = writeln!(
         s,
-        "memory:    about {:.0} MB per worker x {workers} worker(s) (520 B per cell for one kernel, 180 B per cell per further kernel; measured peaks in docs/performance.md)",
-        per_worker / 1e6
+        "memory:    about {:.0} MB per worker x {workers} worker(s) (520 B per cell for one kernel, 180 B per cell per further kernel; measured peaks in docs/performance.md{})",
+        per_worker / 1e6,
+        if stress_bytes > 0.0 {
+            format!("; [stress] {:.0} MB of it", stress_bytes / 1e6)
+        } else {
+            String::new()
+        }
     );
-    let solving: f64 = cases.iter().map(|(_, spec)| case_seconds(spec)).sum();
+    let stress: f64 = match &config.stress {
+        Some(cfg) => {
+            let t: f64 = cases
+                .iter()
+                .map(|(_, spec)| stress_seconds(spec, cfg))
+                .sum();
+            let _ = writeln!(
+                s,
+                "stress:    {} depth kernels a case (planes, slice rows, the surface for SWT), about {:.1} s a case more (measured at 256², scaled as N²)",
+                stress_kernels(cfg),
+                t / cases.len() as f64
+            );
+            t
+        }
+        None => 0.0,
+    };
+    let solving: f64 = stress
+        + cases
+            .iter()
+            .map(|(_, spec)| case_seconds(spec))
+            .sum::<f64>();
     let total = solving
         + kernels
             .values()

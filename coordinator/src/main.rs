@@ -208,13 +208,8 @@ fn worker_count(workers: Option<usize>) -> Result<usize> {
 
 /// The dry-run report, headed by the config's path.
 fn check_report(path: &std::path::Path, config: &Config, workers: usize) -> Result<String> {
-    let stress = if config.stress.is_some() {
-        "stress:    [stress] is computed by `mpcontact solve` and Python, not by sweeps: `run` refuses this config\n"
-    } else {
-        ""
-    };
     Ok(format!(
-        "config:    {} (valid)\n{stress}{}nothing was solved or written (dry run)\n",
+        "config:    {} (valid)\n{}nothing was solved or written (dry run)\n",
         path.display(),
         coordinator::dry_run::report(config, workers)?
     ))

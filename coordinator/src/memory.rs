@@ -25,6 +25,36 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
     cells * (BYTES_PER_CELL + KERNEL_BYTES_PER_CELL * kernels.saturating_sub(1) as f64)
 }
 
+/// Estimated extra peak bytes of `[stress]` in a worker on an `n x n` grid
+/// (counted from the arrays, B per cell): one depth kernel at a time (18
+/// spectra of the padded grid, 576), the transforms' scratch (256), per
+/// state the traction spectra (96) and its planes (48 each, the surface's
+/// for SWT included), and the Crossland and SWT maps (8 each). 256², Fe,
+/// one state, one plane and 25 slice rows: 115 MB with the solve's 46;
+/// measured peak of `mpcontact solve --threads 1` 107 MB (35.5 MB without
+/// the section; docs/validation.md).
+pub fn stress_bytes(n: usize, cfg: &crate::config::StressCfg, states: usize) -> f64 {
+    let cells = (n * n) as f64;
+    let planes = (cfg.depths_um.len() + 1) as f64;
+    let states = states.max(1) as f64;
+    cells * (576.0 + 256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
+}
+
+/// The most states a case of `cases` has its stresses computed at (the
+/// turning points of a load history with `stress.states = "turning"`).
+pub fn stress_states<'a>(
+    cfg: &crate::config::StressCfg,
+    specs: impl Iterator<Item = &'a solver::CaseSpec>,
+) -> usize {
+    specs
+        .map(|s| match (&s.history, cfg.states.as_str()) {
+            (Some(h), "turning") => h.turning_points(&s.load).len(),
+            _ => 1,
+        })
+        .max()
+        .unwrap_or(1)
+}
+
 /// `MemAvailable` of `/proc/meminfo`, bytes; `None` where it cannot be read.
 pub fn available_bytes() -> Option<f64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;

@@ -233,7 +233,11 @@ pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
     let spec = &case.spec;
     crate::memory::check_fits(
         &format!("this case ({0} x {0} cells)", spec.grid.n),
-        crate::memory::worker_bytes(spec.grid.n, 1),
+        crate::memory::worker_bytes(spec.grid.n, 1)
+            + case.stress.as_ref().map_or(0.0, |cfg| {
+                let states = crate::memory::stress_states(cfg, std::iter::once(spec));
+                crate::memory::stress_bytes(spec.grid.n, cfg, states)
+            }),
         1,
         crate::memory::available_bytes(),
     )?;

@@ -7,131 +7,50 @@
 use std::path::Path;
 
 use anyhow::{anyhow, Result};
-use serde::Serialize;
-use solver::stress::{max_principal, tresca, von_mises, Line, StressField, StressPlan, COMPONENTS};
+use solver::stress::{max_principal, tresca, von_mises, COMPONENTS};
+pub use solver::stress_summary::{
+    Located, StateScalars, StateStress, StressRequest, StressScalars, SwtScalars,
+    CROSSLAND_DEFINITION, MAXIMA_DEFINITION, SWT_DEFINITION,
+};
 use solver::{CaseScalars, CaseSpec, Fields, TurningState};
 
 use crate::config::StressCfg;
 use crate::float_text::fmt_f64;
 
-/// How the Crossland parameter is formed from the states computed.
-pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the extremes of a fretting cycle; with more, the smallest enclosing sphere's radius exceeds it by at most 2/sqrt(3) for three states and sqrt(5/3) for more), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
-
-/// Where the maxima are sought.
-pub const MAXIMA_DEFINITION: &str = "maxima over the points computed: every plane of stress.depths_um and the two slices (the grid row and column through the cell nearest the pressure centroid; 'along' is the one nearer the force direction); the surface peak is the stress along the force direction, sigma_tt = sxx c^2 + syy s^2 + 2 sxy s c, on the top row of the 'along' slice";
-
-/// A value and its place (m; z into the body).
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
-pub struct Located {
-    /// The value, Pa.
-    pub value_pa: f64,
-    /// The value over the Hertz pressure p_H.
-    pub over_p_h: f64,
-    /// x, y, z of the point, m.
-    pub at_m: [f64; 3],
-}
-
-/// The scalars of one state.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct StateScalars {
-    /// Increment of the load history (None: the case's only state).
-    pub step: Option<usize>,
-    /// Largest von Mises stress.
-    pub max_von_mises: Located,
-    /// Largest Tresca (maximum shear) stress.
-    pub max_tresca: Located,
-    /// Largest principal stress.
-    pub max_principal: Located,
-    /// Peak surface stress along the force direction (with slices).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub surface_peak_along_force: Option<Located>,
-}
-
-/// What `case.json` carries under `stress`.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct StressScalars {
-    /// One entry per state computed.
-    pub states: Vec<StateScalars>,
-    /// Crossland's parameter over the states (two or more).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub crossland: Option<Located>,
-    /// Crossland's α.
-    pub crossland_alpha: f64,
-    /// See [`CROSSLAND_DEFINITION`].
-    pub crossland_definition: &'static str,
-    /// See [`MAXIMA_DEFINITION`].
-    pub maxima_definition: &'static str,
-    /// Depths of the slices' rows, m.
-    pub slice_depths_m: Vec<f64>,
-    /// The slice along the force: `x` (a grid row) or `y` (a column).
-    pub slice_along: &'static str,
-    /// The cell centre the slices pass through (x, y), m.
-    pub slice_through_m: [f64; 2],
-}
-
-/// One state's stresses on the planes and slices.
-pub struct StateStress {
-    /// Increment (None: the case's only state).
-    pub step: Option<usize>,
-    /// Pressure of the state (for the contact edge in the maps), Pa.
-    pub p: Vec<f64>,
-    /// One field per depth of `stress.depths_um`.
-    pub planes: Vec<StressField>,
-    /// The slice along the force: one line per slice depth.
-    pub along: Vec<StressField>,
-    /// The slice across the force.
-    pub across: Vec<StressField>,
-}
-
-/// The stresses of a case: its states, and the scalars.
+/// The stresses of a case ([`solver::stress_summary::CaseStress`]) and the
+/// depths of its planes as configured (µm, for the file names).
 pub struct StressOutput {
-    /// The states.
-    pub states: Vec<StateStress>,
-    /// The scalars (`case.json`).
-    pub scalars: StressScalars,
-    /// Crossland's parameter on each plane (with two states or more).
-    pub crossland_planes: Vec<Vec<f64>>,
-    /// Crossland's parameter on the slices (rows = depths).
-    pub crossland_slices: Option<[Vec<f64>; 2]>,
-    /// Grid row and column of the slices.
-    pub centre: (usize, usize),
-    /// The slice along the force is a grid row.
-    pub along_is_row: bool,
-    depths_m: Vec<f64>,
+    /// The stresses, fields and scalars.
+    pub case: solver::stress_summary::CaseStress,
     depths_um: Vec<f64>,
-    grid: solver::Grid,
-    contact_radius_m: f64,
-    p_h: f64,
 }
 
-/// A state's increment (None: the case's only state) and its `p, qx, qy`.
-type StateTractions<'a> = (Option<usize>, &'a [f64], &'a [f64], &'a [f64]);
+impl std::ops::Deref for StressOutput {
+    type Target = solver::stress_summary::CaseStress;
+    fn deref(&self) -> &Self::Target {
+        &self.case
+    }
+}
 
 /// A scalar of the stress tensor.
 type Invariant = fn([f64; 6]) -> f64;
 
-/// Cell nearest the pressure centroid.
-fn centroid(grid: &solver::Grid, p: &[f64]) -> (usize, usize) {
-    let n = grid.n;
-    let (mut w, mut sx, mut sy) = (0.0, 0.0, 0.0);
-    for iy in 0..n {
-        for ix in 0..n {
-            let v = p[iy * n + ix];
-            w += v;
-            sx += v * ix as f64;
-            sy += v * iy as f64;
+impl StressCfg {
+    /// The solver's form of the section.
+    pub fn request(&self) -> StressRequest {
+        StressRequest {
+            depths_m: self.depths_um.iter().map(|d| d * 1e-6).collect(),
+            slices: self.slices,
+            slice_depth_m: self.slice_depth_um.map(|d| d * 1e-6),
+            slice_rows: self.slice_rows,
+            turning_states: self.states == "turning",
+            crossland_alpha: self.crossland_alpha,
         }
     }
-    if w <= 0.0 {
-        return (n / 2, n / 2);
-    }
-    let r = |v: f64| (v / w).round().clamp(0.0, (n - 1) as f64) as usize;
-    (r(sx), r(sy))
 }
 
-/// Computes the stresses `cfg` asks for on the states of a solved case:
-/// the turning points of its load history (or its final state), else
-/// the case's one state.
+/// Computes the stresses `cfg` asks for on the states of a solved case
+/// (see [`solver::stress_summary::compute`]).
 pub fn compute(
     cfg: &StressCfg,
     spec: &CaseSpec,
@@ -139,215 +58,11 @@ pub fn compute(
     fields: &Fields,
     turning: &[TurningState],
 ) -> Result<StressOutput> {
-    let grid = spec.grid;
-    let n = grid.n;
-    let states: Vec<StateTractions> = if cfg.states == "turning" && !turning.is_empty() {
-        turning
-            .iter()
-            .map(|t| (Some(t.step), &t.p[..], &t.qx[..], &t.qy[..]))
-            .collect()
-    } else {
-        vec![(None, &fields.p[..], &fields.qx[..], &fields.qy[..])]
-    };
-    let mut plan = StressPlan::new(&spec.material, grid).map_err(|e| anyhow!("[stress]: {e}"))?;
-    let tractions: Vec<_> = states
-        .iter()
-        .map(|(_, p, qx, qy)| plan.tractions(p, qx, qy))
-        .collect();
-    let (ix0, iy0) = centroid(&grid, &fields.p);
-    let psi = spec.load.angle_deg.to_radians();
-    let along_is_row = psi.cos().abs() >= psi.sin().abs();
-    let (along, across) = if along_is_row {
-        (Line::Row(iy0), Line::Column(ix0))
-    } else {
-        (Line::Column(ix0), Line::Row(iy0))
-    };
-    let a = if scalars.contact_radius_m > 0.0 {
-        scalars.contact_radius_m
-    } else {
-        scalars.hertz_radius_m
-    };
-    let slice_depths: Vec<f64> = if cfg.slices {
-        let deepest = cfg.slice_depth_um.map_or(2.0 * a, |d| d * 1e-6);
-        (0..cfg.slice_rows)
-            .map(|k| deepest * k as f64 / (cfg.slice_rows - 1) as f64)
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let mut out: Vec<StateStress> = states
-        .iter()
-        .map(|(step, p, _, _)| StateStress {
-            step: *step,
-            p: p.to_vec(),
-            planes: Vec::new(),
-            along: Vec::new(),
-            across: Vec::new(),
-        })
-        .collect();
-    // One kernel per depth, applied to every state.
-    for &z in &slice_depths {
-        let plane = plan.plane(z).map_err(|e| anyhow!("[stress]: {e}"))?;
-        for (s, t) in out.iter_mut().zip(&tractions) {
-            s.along.push(plan.apply_line(&plane, t, along));
-            s.across.push(plan.apply_line(&plane, t, across));
-        }
-    }
-    let depths_m: Vec<f64> = cfg.depths_um.iter().map(|d| d * 1e-6).collect();
-    for &z in &depths_m {
-        let plane = plan.plane(z).map_err(|e| anyhow!("[stress]: {e}"))?;
-        for (s, t) in out.iter_mut().zip(&tractions) {
-            s.planes.push(plan.apply(&plane, t));
-        }
-    }
-    let p_h = scalars.hertz_pressure_pa;
-    let at_line = |line: Line, i: usize, z: f64| match line {
-        Line::Row(iy) => [grid.x(i), grid.y(iy), z],
-        Line::Column(ix) => [grid.x(ix), grid.y(i), z],
-    };
-    let located = |v: f64, at: [f64; 3]| Located {
-        value_pa: v,
-        over_p_h: v / p_h,
-        at_m: at,
-    };
-    // Every point computed of a state: (tensor, place).
-    let points = |s: &StateStress| -> Vec<([f64; 6], [f64; 3])> {
-        let mut pts = Vec::new();
-        for (line, rows) in [(along, &s.along), (across, &s.across)] {
-            for f in rows.iter() {
-                for i in 0..f.len() {
-                    pts.push((f.at(i), at_line(line, i, f.depth_m)));
-                }
-            }
-        }
-        for f in &s.planes {
-            for i in 0..f.len() {
-                pts.push((f.at(i), [grid.x(i % n), grid.y(i / n), f.depth_m]));
-            }
-        }
-        pts
-    };
-    let best = |pts: &[([f64; 6], [f64; 3])], f: &dyn Fn([f64; 6]) -> f64| {
-        let mut b = (f64::NEG_INFINITY, [0.0; 3]);
-        for (s, at) in pts {
-            let v = f(*s);
-            if v > b.0 {
-                b = (v, *at);
-            }
-        }
-        located(b.0, b.1)
-    };
-    let (c, s) = (psi.cos(), psi.sin());
-    let along_force = |t: [f64; 6]| t[0] * c * c + t[1] * s * s + 2.0 * t[5] * s * c;
-    let mut state_scalars = Vec::new();
-    for st in &out {
-        let pts = points(st);
-        let surface_peak = st.along.first().map(|top| {
-            let vals = top.map(along_force);
-            let pk = solver::stress::peak(&vals).expect("a line has points");
-            located(pk.value, at_line(along, pk.index, 0.0))
-        });
-        state_scalars.push(StateScalars {
-            step: st.step,
-            max_von_mises: best(&pts, &von_mises),
-            max_tresca: best(&pts, &tresca),
-            max_principal: best(&pts, &max_principal),
-            surface_peak_along_force: surface_peak,
-        });
-    }
-    // Crossland over the states.
-    let alpha = cfg.crossland_alpha;
-    let crossland_at = |ts: &[[f64; 6]]| -> f64 {
-        let dev = |t: &[f64; 6]| {
-            let m = (t[0] + t[1] + t[2]) / 3.0;
-            [t[0] - m, t[1] - m, t[2] - m, t[3], t[4], t[5]]
-        };
-        let mut amp: f64 = 0.0;
-        for i in 0..ts.len() {
-            for j in i + 1..ts.len() {
-                let (a, b) = (dev(&ts[i]), dev(&ts[j]));
-                let d: [f64; 6] = std::array::from_fn(|k| 0.5 * (a[k] - b[k]));
-                let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                    + d[3] * d[3]
-                    + d[4] * d[4]
-                    + d[5] * d[5];
-                amp = amp.max(j2.sqrt());
-            }
-        }
-        let sh = ts
-            .iter()
-            .map(|t| (t[0] + t[1] + t[2]) / 3.0)
-            .fold(f64::NEG_INFINITY, f64::max);
-        amp + alpha * sh
-    };
-    let (mut crossland_planes, mut crossland_slices, mut crossland) = (Vec::new(), None, None);
-    if out.len() >= 2 {
-        let field_of = |get: &dyn Fn(&StateStress) -> &StressField| -> Vec<f64> {
-            let len = get(&out[0]).len();
-            (0..len)
-                .map(|i| {
-                    let ts: Vec<[f64; 6]> = out.iter().map(|s| get(s).at(i)).collect();
-                    crossland_at(&ts)
-                })
-                .collect()
-        };
-        for k in 0..depths_m.len() {
-            crossland_planes.push(field_of(&|s: &StateStress| &s.planes[k]));
-        }
-        let slice = |which: usize| -> Vec<f64> {
-            (0..slice_depths.len())
-                .flat_map(|r| {
-                    if which == 0 {
-                        field_of(&|s: &StateStress| &s.along[r])
-                    } else {
-                        field_of(&|s: &StateStress| &s.across[r])
-                    }
-                })
-                .collect()
-        };
-        if !slice_depths.is_empty() {
-            crossland_slices = Some([slice(0), slice(1)]);
-        }
-        let mut b = (f64::NEG_INFINITY, [0.0; 3]);
-        for (k, f) in crossland_planes.iter().enumerate() {
-            for (i, &v) in f.iter().enumerate() {
-                if v > b.0 {
-                    b = (v, [grid.x(i % n), grid.y(i / n), depths_m[k]]);
-                }
-            }
-        }
-        if let Some(sl) = &crossland_slices {
-            for (line, vals) in [(along, &sl[0]), (across, &sl[1])] {
-                for (i, &v) in vals.iter().enumerate() {
-                    if v > b.0 {
-                        b = (v, at_line(line, i % n, slice_depths[i / n]));
-                    }
-                }
-            }
-        }
-        crossland = Some(located(b.0, b.1));
-    }
+    let case = solver::stress_summary::compute(&cfg.request(), spec, scalars, fields, turning)
+        .map_err(|e| anyhow!("[stress]: {e}"))?;
     Ok(StressOutput {
-        scalars: StressScalars {
-            states: state_scalars,
-            crossland,
-            crossland_alpha: alpha,
-            crossland_definition: CROSSLAND_DEFINITION,
-            maxima_definition: MAXIMA_DEFINITION,
-            slice_depths_m: slice_depths,
-            slice_along: if along_is_row { "x" } else { "y" },
-            slice_through_m: [grid.x(ix0), grid.y(iy0)],
-        },
-        states: out,
-        crossland_planes,
-        crossland_slices,
-        centre: (ix0, iy0),
-        along_is_row,
-        depths_m,
+        case,
         depths_um: cfg.depths_um.clone(),
-        grid,
-        contact_radius_m: a,
-        p_h,
     })
 }
 
@@ -375,7 +90,8 @@ pub struct StressArray {
 /// `slice_<along|across>_<c>` (rows = `slice_depths_m`, columns along the
 /// line), `c` the six components (`sxx` … `sxy`), `von_mises`, `tresca`,
 /// `s1`; with two states or more `plane_<z>um_crossland` and
-/// `slice_<along|across>_crossland`. The files of [`write`] and Python's
+/// `slice_<along|across>_crossland`; `surface_swt` (n x n, Smith–Watson–Topper
+/// over the surface). The files of [`write`] and Python's
 /// `Result.stress`.
 pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
     let n = so.grid.n;
@@ -430,6 +146,7 @@ pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
         push("slice_along_crossland".into(), rows, al.clone());
         push("slice_across_crossland".into(), rows, ac.clone());
     }
+    push("surface_swt".into(), n, so.swt_surface.clone());
     out
 }
 

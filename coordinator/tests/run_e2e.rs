@@ -1664,3 +1664,232 @@ fn issue39_orientations_are_the_single_crystals_and_map_the_triangle() {
     );
     assert!(shm_leftovers("o").is_empty());
 }
+
+/// Two cases of Cu at 32² (the sweep above's flat surface at 0° and 45°),
+/// the stresses asked for on the surface and at 1 mm and on 8-row slices.
+const STRESS_SWEEP: &str = r#"
+[grid]
+points = 32
+spacing_um = 200.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.3
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["flat"]
+angles_deg = [0.0, 45.0]
+
+[solver]
+coupling = false
+tolerance = 1e-6
+max_iterations = 2000
+"#;
+
+const STRESS_SECTION: &str = "\n[stress]\ndepths_um = [0.0, 1000.0]\nslice_rows = 8\n";
+
+/// Issue 38 in sweeps: with `[stress]` the workers' stress scalars are in
+/// results.csv, curves.csv, summary.json and `fields/<case>/stress.json`,
+/// equal to the bit to what `mpcontact solve` writes for the same case
+/// (case.json's `stress`, and the `.npy` arrays with `--save-fields`);
+/// without the section the sweep's header has no new column and its
+/// physics columns are those of the sweep with it.
+#[test]
+fn issue38_a_sweep_computes_the_stresses_of_solve_and_only_with_the_section() {
+    let d = scratch("stress");
+    std::fs::write(
+        d.join("sweep.toml"),
+        format!("{STRESS_SWEEP}{STRESS_SECTION}"),
+    )
+    .unwrap();
+    let mut cmd = sweep_cmd(&d, "with", 1, "st");
+    cmd.arg("--save-fields");
+    check_ok(&cmd.output().unwrap(), "sweep with [stress]");
+    let with = d.join("with");
+    let rows = read_csv(&with.join("results.csv"));
+    let header = rows[0].join(",");
+    let stress_cols = coordinator::run::RESULTS_STRESS_COLUMNS;
+    assert_eq!(
+        header,
+        format!("{},{stress_cols}", coordinator::run::RESULTS_HEADER)
+    );
+    let col = |name: &str| rows[0].iter().position(|h| h == name).unwrap();
+    for angle in ["0", "45"] {
+        let row = rows.iter().find(|r| r[col("angle_deg")] == angle).unwrap();
+        // The same case through `mpcontact solve`.
+        let out = d.join(format!("solve{angle}"));
+        let o = Command::new(EXE)
+            .arg("solve")
+            .arg(d.join("sweep.toml"))
+            .args(["--angle-deg", angle, "--quiet", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        check_ok(&o, "solve");
+        let case: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("case.json")).unwrap()).unwrap();
+        let stress = &case["stress"];
+        let fields = with.join(format!(
+            "fields/Cu/flat/{:05.1}",
+            angle.parse::<f64>().unwrap()
+        ));
+        let written: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(fields.join("stress.json")).unwrap())
+                .unwrap();
+        assert_eq!(
+            &written, stress,
+            "stress.json of the sweep = case.json's stress"
+        );
+        // One state: the CSV's cells are that state's values, to the bit.
+        let st = &stress["states"][0];
+        let bits = |cell: &str| cell.parse::<f64>().unwrap().to_bits();
+        let json_bits = |v: &serde_json::Value| v.as_f64().unwrap().to_bits();
+        for (name, v) in [
+            ("max_von_mises_pa", &st["max_von_mises"]["value_pa"]),
+            ("max_von_mises_over_p_h", &st["max_von_mises"]["over_p_h"]),
+            ("max_von_mises_z_m", &st["max_von_mises"]["at_m"][2]),
+            ("max_tresca_pa", &st["max_tresca"]["value_pa"]),
+            ("max_principal_pa", &st["max_principal"]["value_pa"]),
+            (
+                "surface_peak_pa",
+                &st["surface_peak_along_force"]["value_pa"],
+            ),
+            (
+                "surface_peak_x_m",
+                &st["surface_peak_along_force"]["at_m"][0],
+            ),
+            ("swt_pa", &stress["swt"]["value_pa"]),
+            ("swt_plane_deg", &stress["swt"]["plane_angle_deg"]),
+        ] {
+            assert_eq!(bits(&row[col(name)]), json_bits(v), "{name} at {angle}°");
+        }
+        assert_eq!(row[col("crossland_pa")], "", "one state: no Crossland");
+        assert!(
+            bits(&row[col("swt_pa")]) != 0f64.to_bits(),
+            "the surface tension gives SWT > 0"
+        );
+        // The arrays: the same bytes as solve's.
+        for name in [
+            "plane_0um_sxx",
+            "plane_1000um_von_mises",
+            "slice_along_sxz",
+            "surface_swt",
+        ] {
+            let a = std::fs::read(fields.join(format!("stress/{name}.npy"))).unwrap();
+            let b = std::fs::read(out.join(format!("stress/{name}.npy"))).unwrap();
+            assert!(a == b, "{name}.npy differs from solve's");
+        }
+    }
+    let curves = read_csv(&with.join("curves.csv"));
+    assert!(curves[0]
+        .join(",")
+        .ends_with(coordinator::run::CURVES_STRESS_COLUMNS));
+    let s = summary(&with);
+    let range = &s["curves"]["Cu / flat"]["max_von_mises_over_p_h_range"];
+    assert!(range[0].as_f64().unwrap() > 0.3, "{range}");
+
+    // Without the section: no stress column, nothing stress-like written,
+    // and the same physics to the bit.
+    std::fs::write(d.join("sweep.toml"), STRESS_SWEEP).unwrap();
+    check_ok(
+        &sweep_cmd(&d, "without", 1, "sn").output().unwrap(),
+        "sweep without",
+    );
+    let without = d.join("without");
+    let plain = read_csv(&without.join("results.csv"));
+    assert_eq!(plain[0].join(","), coordinator::run::RESULTS_HEADER);
+    assert_eq!(
+        read_csv(&without.join("curves.csv"))[0].join(","),
+        coordinator::run::CURVES_HEADER
+    );
+    let n = plain[0].len();
+    let cut = |rows: &[Vec<String>]| -> Vec<String> {
+        rows.iter()
+            .map(|r| {
+                r[..n]
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| rows[0][*i] != "seconds" && rows[0][*i] != "worker")
+                    .map(|(_, v)| v.clone())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .collect()
+    };
+    assert_eq!(cut(&plain), cut(&rows));
+    assert!(!without.join("fields/Cu/flat/000.0/stress.json").exists());
+    let summary_text = std::fs::read_to_string(without.join("summary.json")).unwrap();
+    assert!(!summary_text.contains("von_mises"));
+    let journal = std::fs::read_to_string(without.join("journal.jsonl")).unwrap();
+    assert!(!journal.contains("\"stress\""));
+}
+
+/// A fretting path in a sweep with `[stress]`: the turning states' scalars
+/// (three states, Crossland, SWT over the cycle) equal `solve`'s to the
+/// bit; their arrays are not written by the sweep (the turning states'
+/// tractions do not travel back) and the run says so; a resumed sweep
+/// rewrites the same results.csv from its journal.
+#[test]
+fn issue38_a_fretting_sweep_keeps_the_turning_states_scalars_and_resumes() {
+    let d = scratch("stress-history");
+    let config = STRESS_SWEEP.replace("angles_deg = [0.0, 45.0]", "angles_deg = [0.0]")
+        + "\n[history]\ntangential_ratios = [0.0, 0.5, -0.5]\nsteps_per_segment = 2\n"
+        + "\n[stress]\ndepths_um = [0.0]\nslice_rows = 4\n";
+    std::fs::write(d.join("sweep.toml"), config).unwrap();
+    let mut cmd = sweep_cmd(&d, "o", 1, "sh");
+    cmd.arg("--save-fields");
+    let out = cmd.output().unwrap();
+    check_ok(&out, "fretting sweep with [stress]");
+    let o = d.join("o");
+    let fields = o.join("fields/Cu/flat/000.0");
+    assert!(fields.join("p.npy").is_file());
+    assert!(!fields.join("stress").exists(), "no turning-state arrays");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("turning states are not written"));
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fields.join("stress.json")).unwrap())
+            .unwrap();
+    let solved = d.join("solve");
+    check_ok(
+        &Command::new(EXE)
+            .arg("solve")
+            .arg(d.join("sweep.toml"))
+            .args(["--quiet", "--out"])
+            .arg(&solved)
+            .output()
+            .unwrap(),
+        "solve",
+    );
+    let case: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(solved.join("case.json")).unwrap()).unwrap();
+    assert_eq!(written, case["stress"]);
+    assert_eq!(written["states"].as_array().unwrap().len(), 3);
+    let rows = read_csv(&o.join("results.csv"));
+    let col = |name: &str| rows[0].iter().position(|h| h == name).unwrap();
+    let bits = |cell: &str| cell.parse::<f64>().unwrap().to_bits();
+    let cl = written["crossland"]["value_pa"].as_f64().unwrap();
+    assert_eq!(bits(&rows[1][col("crossland_pa")]), cl.to_bits());
+    let swt = written["swt"]["value_pa"].as_f64().unwrap();
+    assert_eq!(bits(&rows[1][col("swt_pa")]), swt.to_bits());
+    // The worst state's von Mises is the CSV's.
+    let vm = written["states"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["max_von_mises"]["value_pa"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(bits(&rows[1][col("max_von_mises_pa")]), vm.to_bits());
+    // Resume: nothing recomputed, the same table from the journal.
+    let before = std::fs::read_to_string(o.join("results.csv")).unwrap();
+    let mut again = sweep_cmd(&d, "o", 1, "sr");
+    again.arg("--resume");
+    check_ok(&again.output().unwrap(), "resume");
+    assert_eq!(
+        std::fs::read_to_string(o.join("results.csv")).unwrap(),
+        before
+    );
+}

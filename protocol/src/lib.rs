@@ -62,7 +62,9 @@ pub use wire::{
 /// energy ratio and slip regime: a worker of another build is refused
 /// cleanly instead of misreading them.
 /// 4: a patterned surface in the payload carries its sampling (issue #34).
-pub const PROTOCOL_VERSION: u32 = 4;
+/// 5: an assignment may ask for the stresses below the surface (`[stress]`,
+/// issue #38) and a result carries their scalars.
+pub const PROTOCOL_VERSION: u32 = 5;
 
 #[cfg(test)]
 mod tests;

@@ -86,6 +86,7 @@ mod progress;
 mod results;
 mod spec;
 pub mod stress;
+pub mod stress_summary;
 mod surface;
 pub mod tangential;
 pub mod tangential_displacement;

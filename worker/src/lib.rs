@@ -32,16 +32,30 @@ use protocol::{
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use solver::stress_summary::{StressRequest, StressScalars};
 use solver::{solve_case, CaseScalars, CaseSpec, KernelCache, KernelKey};
 
-/// Case specification as it travels on the wire.
-pub type WireSpec = CaseSpec;
+/// Case specification as it travels on the wire: the case, and what of
+/// its stresses below the surface to compute after the solve (`[stress]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WireSpec {
+    /// The case.
+    pub case: CaseSpec,
+    /// With `[stress]`: the stresses to compute from the solved tractions.
+    pub stress: Option<StressRequest>,
+}
+
+impl From<CaseSpec> for WireSpec {
+    fn from(case: CaseSpec) -> Self {
+        WireSpec { case, stress: None }
+    }
+}
 
 /// Result scalars as they travel on the wire: the solver's scalars, checked
-/// for NaN/∞ in the values a results row reports.
+/// for NaN/∞ in the values a results row reports, and the stress scalars
+/// when the assignment asked for them.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(transparent)]
-pub struct WireScalars(pub CaseScalars);
+pub struct WireScalars(pub CaseScalars, pub Option<StressScalars>);
 
 impl CheckFinite for WireScalars {
     fn first_non_finite(&self) -> Option<String> {
@@ -61,7 +75,24 @@ impl CheckFinite for WireScalars {
             ("k_e_cells", s.k_e_cells),
             ("mu_a_cells", s.mu_a_cells.unwrap_or(0.0)),
         ];
-        named
+        if let Some((k, _)) = named.iter().find(|(_, v)| !v.is_finite()) {
+            return Some(k.to_string());
+        }
+        let st = self.1.as_ref()?;
+        let mut located: Vec<(&str, f64)> = Vec::new();
+        for state in &st.states {
+            located.push(("stress.max_von_mises", state.max_von_mises.value_pa));
+            located.push(("stress.max_tresca", state.max_tresca.value_pa));
+            located.push(("stress.max_principal", state.max_principal.value_pa));
+            if let Some(l) = state.surface_peak_along_force {
+                located.push(("stress.surface_peak_along_force", l.value_pa));
+            }
+        }
+        if let Some(l) = st.crossland {
+            located.push(("stress.crossland", l.value_pa));
+        }
+        located.push(("stress.swt", st.swt.value_pa));
+        located
             .iter()
             .find(|(_, v)| !v.is_finite())
             .map(|(k, _)| k.to_string())
@@ -199,11 +230,28 @@ fn solve_one<K: WireKey>(
     keys: &mut HashSet<KernelKey>,
 ) -> (WorkerMessage<K>, Option<solver::Fields>) {
     let start = Instant::now();
-    keys.insert(KernelKey::of(&case.spec));
-    let solved = solve_case(&case.spec, cache);
+    keys.insert(KernelKey::of(&case.spec.case));
+    let solved = solve_case(&case.spec.case, cache).and_then(|out| {
+        // The stresses below the surface, from the solved tractions: the
+        // same function `mpcontact solve` calls, on the same inputs.
+        let stress = match &case.spec.stress {
+            Some(req) => Some(
+                solver::stress_summary::compute(
+                    req,
+                    &case.spec.case,
+                    &out.scalars,
+                    &out.fields,
+                    &out.turning,
+                )?
+                .scalars,
+            ),
+            None => None,
+        };
+        Ok((out, stress))
+    });
     let solve_seconds = start.elapsed().as_secs_f64();
     match solved {
-        Ok(out) => {
+        Ok((out, stress)) => {
             let want = case.want_fields;
             let header = ResultHeader {
                 key: case.key.clone(),
@@ -219,7 +267,7 @@ fn solve_one<K: WireKey>(
                 } else {
                     Vec::new()
                 },
-                scalars: WireScalars(out.scalars),
+                scalars: WireScalars(out.scalars, stress),
             };
             (ToCoord::Result(header), want.then_some(out.fields))
         }
@@ -450,7 +498,7 @@ mod tests {
             grid_n: spec.grid.n as u32,
             want_fields,
             attempt: 0,
-            spec,
+            spec: spec.into(),
         }
     }
 

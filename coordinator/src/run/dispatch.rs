@@ -65,6 +65,8 @@ pub struct DispatchArgs<'a> {
     pub save_fields: bool,
     /// Progress reporter.
     pub progress: &'a Progress,
+    /// `[stress]`: what the workers compute below the surface of each case.
+    pub stress: Option<crate::config::StressCfg>,
 }
 
 /// What a run's dispatch measured, for the summary.
@@ -262,6 +264,19 @@ impl<'a> Dispatch<'a> {
                 &h.field_names,
                 field_bytes,
             )?;
+            if let Some(cfg) = &self.args.stress {
+                let note = output::write_stress_fields(
+                    self.args.out_dir,
+                    &case.key,
+                    &case.spec,
+                    cfg,
+                    &h.scalars.0,
+                    (&h.field_names, field_bytes),
+                )?;
+                if let Some(note) = note {
+                    self.note(&note);
+                }
+            }
         }
         if let Some(peer) = self.peers.get_mut(&worker) {
             peer.stats.kernel_loads = peer.stats.kernel_loads.max(h.kernel_loads);
@@ -273,6 +288,7 @@ impl<'a> Dispatch<'a> {
             seconds: h.solve_seconds,
             kernel_builds: h.kernel_builds,
             scalars: Some(h.scalars.0),
+            stress: h.scalars.1,
         };
         self.record(rec, i, worker, outcome)?;
         self.ipc
@@ -349,7 +365,10 @@ impl<'a> Dispatch<'a> {
                 grid_n: case.spec.grid.n as u32,
                 want_fields: self.args.save_fields,
                 attempt: case.attempts,
-                spec: case.spec.clone(),
+                spec: worker::WireSpec {
+                    case: case.spec.clone(),
+                    stress: self.args.stress.as_ref().map(|s| s.request()),
+                },
             });
             if let Err(e) = ex.respond(&request, &msg) {
                 self.args

@@ -32,6 +32,11 @@ pub struct Outcome {
     pub kernel_builds: u64,
     /// Scalars as computed by the worker (μa before K_E calibration).
     pub scalars: Option<CaseScalars>,
+    /// With `[stress]`: the stress scalars the worker computed (absent
+    /// from the journal line otherwise, so sweeps without the section
+    /// journal as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stress: Option<solver::stress_summary::StressScalars>,
 }
 
 impl Outcome {
@@ -44,6 +49,7 @@ impl Outcome {
             seconds,
             kernel_builds,
             scalars: None,
+            stress: None,
         }
     }
 }
@@ -299,6 +305,7 @@ mod tests {
                 seconds: 0.1,
                 kernel_builds: 1,
                 scalars: Some(CaseScalars::default()),
+                stress: None,
             },
         )
     }

@@ -34,7 +34,7 @@ pub use fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
 pub use orientation_map::ORIENTATIONS_HEADER;
-pub use output::{CURVES_HEADER, RESULTS_HEADER};
+pub use output::{CURVES_HEADER, CURVES_STRESS_COLUMNS, RESULTS_HEADER, RESULTS_STRESS_COLUMNS};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
 pub use supervise::WorkerCommand;
@@ -81,11 +81,6 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
-    // Not silently dropped: a sweep's workers do not compute stresses (yet).
-    anyhow::ensure!(
-        args.config.stress.is_none(),
-        "[stress]: stresses below the surface are computed by `mpcontact solve` and the Python module, not yet by sweeps; solve the cases of interest one by one, or leave the section out"
-    );
     if args.out_dir.exists() && !args.out_dir.is_dir() {
         anyhow::bail!(
             "--out {}: exists and is not a directory",
@@ -117,9 +112,14 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     }
     let plan = Plan::new(cases);
     let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
+    let n = args.config.finest_points();
+    let stress_bytes = args.config.stress.as_ref().map_or(0.0, |cfg| {
+        let states = crate::memory::stress_states(cfg, plan.cases.iter().map(|c| &c.spec));
+        crate::memory::stress_bytes(n, cfg, states)
+    });
     crate::memory::check_fits(
         "the sweep",
-        crate::memory::worker_bytes(args.config.finest_points(), kernels.len()),
+        crate::memory::worker_bytes(n, kernels.len()) + stress_bytes,
         args.workers,
         crate::memory::available_bytes(),
     )?;
@@ -157,6 +157,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
             out_dir: &args.out_dir,
             save_fields: args.save_fields || args.config.output.save_fields,
             progress: &progress,
+            stress: args.config.stress.clone(),
         });
         let outcome = start_workers(&mut dispatch, &mut supervisor, workers, &progress)
             .and_then(|()| dispatch.serve(&exchange, &mut supervisor, &mut recorder));
@@ -289,6 +290,18 @@ fn write_outputs(
                 .output_warnings
                 .push(format!("history of {key}: {e:#}")),
         }
+    }
+    // With [stress]: each case's stress scalars beside its fields, the
+    // value `mpcontact solve` puts under `stress` in case.json.
+    for r in &rows {
+        let Some(s) = &r.record.stress else {
+            continue;
+        };
+        let dir = output::fields_dir(dir, &r.case.key);
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
+        let text = serde_json::to_string_pretty(s)? + "\n";
+        crate::atomic::write(&dir.join("stress.json"), text.as_bytes())?;
     }
     // A fretting map (sweep.amplitudes_um): its table, transitions, figure.
     let map = fretting_map::map_points(&rows);

@@ -24,6 +24,54 @@ pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,con
 /// Header of `curves.csv`.
 pub const CURVES_HEADER: &str =
     "material,surface,angle_deg,mu_a,mu_a_err,k_e,k_e_err,method,order,mu_a_by_level,mu_a_cells";
+/// Columns `results.csv` gains when the sweep computes stresses below the
+/// surface (`[stress]`): over the states of a case, the largest von Mises
+/// stress (Pa, over p_H, and its point), the largest Tresca and principal
+/// stresses, the peak surface stress along the force (the trailing-edge
+/// tension) and its point, Crossland's parameter (two states or more) and
+/// its depth, and Smith–Watson–Topper's at the surface with its point and
+/// critical plane. A sweep without the section has the header above, to the byte.
+pub const RESULTS_STRESS_COLUMNS: &str = "max_von_mises_pa,max_von_mises_over_p_h,max_von_mises_x_m,max_von_mises_y_m,max_von_mises_z_m,max_tresca_pa,max_tresca_over_p_h,max_principal_pa,max_principal_over_p_h,surface_peak_pa,surface_peak_over_p_h,surface_peak_x_m,surface_peak_y_m,crossland_pa,crossland_z_m,swt_pa,swt_x_m,swt_y_m,swt_plane_deg";
+
+/// Columns `curves.csv` gains with `[stress]` (the finest level's case).
+pub const CURVES_STRESS_COLUMNS: &str =
+    "max_von_mises_over_p_h,max_tresca_over_p_h,surface_peak_over_p_h,swt_pa";
+
+/// The cells of [`RESULTS_STRESS_COLUMNS`] (empty without stress scalars).
+fn stress_cells(s: Option<&solver::stress_summary::StressScalars>) -> String {
+    use solver::stress_summary::Located;
+    let Some(s) = s else {
+        return ",".repeat(RESULTS_STRESS_COLUMNS.matches(',').count());
+    };
+    let vm = s.worst(|st| Some(st.max_von_mises));
+    let tr = s.worst(|st| Some(st.max_tresca));
+    let pr = s.worst(|st| Some(st.max_principal));
+    let sp = s.worst(|st| st.surface_peak_along_force);
+    let v = |l: Option<Located>, g: fn(&Located) -> f64| opt(l.as_ref().map(g));
+    [
+        v(vm, |l| l.value_pa),
+        v(vm, |l| l.over_p_h),
+        v(vm, |l| l.at_m[0]),
+        v(vm, |l| l.at_m[1]),
+        v(vm, |l| l.at_m[2]),
+        v(tr, |l| l.value_pa),
+        v(tr, |l| l.over_p_h),
+        v(pr, |l| l.value_pa),
+        v(pr, |l| l.over_p_h),
+        v(sp, |l| l.value_pa),
+        v(sp, |l| l.over_p_h),
+        v(sp, |l| l.at_m[0]),
+        v(sp, |l| l.at_m[1]),
+        v(s.crossland, |l| l.value_pa),
+        v(s.crossland, |l| l.at_m[2]),
+        fmt_f64(s.swt.value_pa),
+        fmt_f64(s.swt.at_m[0]),
+        fmt_f64(s.swt.at_m[1]),
+        fmt_f64(s.swt.plane_angle_deg),
+    ]
+    .join(",")
+}
+
 /// The column both CSVs gain, after `surface`, in a sweep over balls
 /// (`sweep.indenters`): the ball's name, `rigid` for none. A sweep without
 /// that axis has the headers above, to the byte.
@@ -147,14 +195,19 @@ fn opt(v: Option<f64>) -> String {
 /// Text of `results.csv` (with [`INDENTER_COLUMN`] in a sweep over balls).
 pub fn results_csv(rows: &[Row]) -> String {
     let axes = Axes::of(rows.iter().map(|r| &r.case.key));
+    let stress = rows.iter().any(|r| r.record.stress.is_some());
     let mut out = header_with_axes(RESULTS_HEADER, axes);
+    if stress {
+        out.push(',');
+        out.push_str(RESULTS_STRESS_COLUMNS);
+    }
     out.push('\n');
     for r in rows {
         let c = r.case;
         let s = r.scalars.as_ref();
         let f = |g: fn(&CaseScalars) -> f64| opt(s.map(g));
         let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
-        let _ = writeln!(
+        let _ = write!(
             out,
             "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
             identity_cells(&c.key, axes),
@@ -182,6 +235,11 @@ pub fn results_csv(rows: &[Row]) -> String {
             f(|s| s.contact_radius_cells_m),
             f(|s| s.stick_radius_cells_m),
         );
+        if stress {
+            out.push(',');
+            out.push_str(&stress_cells(r.record.stress.as_ref()));
+        }
+        out.push('\n');
     }
     out
 }
@@ -214,6 +272,8 @@ pub struct CurvePoint {
     /// Energy dissipated per load cycle (cases with a `[history]` that
     /// closes a cycle), J: best value and error bar over the levels.
     pub dissipated: Option<Estimate>,
+    /// With `[stress]`: the finest level's stress scalars.
+    pub stress: Option<solver::stress_summary::StressScalars>,
 }
 
 /// The curve points of `rows`: each material × surface × angle whose
@@ -271,6 +331,11 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             flat_calibration: rs[0].case.spec.surface == solver::Surface::Flat
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
             dissipated,
+            stress: rs
+                .iter()
+                .rev()
+                .find(|r| r.record.status == Status::Ok)
+                .and_then(|r| r.record.stress.clone()),
         });
     }
     (points, incomplete)
@@ -284,11 +349,16 @@ pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
 /// per cycle).
 pub fn curves_csv(points: &[CurvePoint]) -> String {
     let history = points.iter().any(|p| p.dissipated.is_some());
+    let stress = points.iter().any(|p| p.stress.is_some());
     let axes = Axes::of(points.iter().map(|p| &p.key));
     let mut out = header_with_axes(CURVES_HEADER, axes);
     if history {
         out.push(',');
         out.push_str(CURVES_HISTORY_COLUMNS);
+    }
+    if stress {
+        out.push(',');
+        out.push_str(CURVES_STRESS_COLUMNS);
     }
     out.push('\n');
     for p in points {
@@ -315,6 +385,22 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
                 opt(p.dissipated.as_ref().and_then(|d| d.err)),
             );
         }
+        if stress {
+            let s = p.stress.as_ref();
+            let worst = |f: fn(
+                &solver::stress_summary::StateScalars,
+            ) -> Option<solver::stress_summary::Located>| {
+                opt(s.and_then(|s| s.worst(f)).map(|l| l.over_p_h))
+            };
+            let _ = write!(
+                out,
+                ",{},{},{},{}",
+                worst(|st| Some(st.max_von_mises)),
+                worst(|st| Some(st.max_tresca)),
+                worst(|st| st.surface_peak_along_force),
+                opt(s.map(|s| s.swt.value_pa)),
+            );
+        }
         out.push('\n');
     }
     out
@@ -335,6 +421,16 @@ pub struct CurveSummary {
     /// the sum of the error bars at the two extremes (None without a ladder
     /// or with one angle).
     pub resolved: Option<bool>,
+    /// With `[stress]`: the smallest and largest over angle of the
+    /// largest von Mises stress over p_H (worst state of each case).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_von_mises_over_p_h_range: Option<[f64; 2]>,
+    /// With `[stress]`: the angle of the largest of those, degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_von_mises_worst_angle_deg: Option<f64>,
+    /// With `[stress]`: the smallest and largest SWT over angle, Pa.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub swt_range_pa: Option<[f64; 2]>,
 }
 
 /// A curve: material, and the surface's name in the figure's legend and
@@ -384,6 +480,29 @@ pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> 
             (Some(el), Some(eh)) if pts.len() > 1 => Some(hi.mu_a.value - lo.mu_a.value > el + eh),
             _ => None,
         };
+        // Over angle, of every point's stress scalars (None without them).
+        let range = |f: &dyn Fn(&solver::stress_summary::StressScalars) -> Option<f64>| {
+            let v: Option<Vec<(f64, f64)>> = pts
+                .iter()
+                .map(|p| Some((f(p.stress.as_ref()?)?, p.key.angle_deg)))
+                .collect();
+            let v = v.filter(|v| !v.is_empty())?;
+            let lo = v.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
+            let hi =
+                v.iter().copied().fold(
+                    (f64::NEG_INFINITY, 0.0),
+                    |b, x| {
+                        if x.0 > b.0 {
+                            x
+                        } else {
+                            b
+                        }
+                    },
+                );
+            Some(([lo, hi.0], hi.1))
+        };
+        let vm = range(&|s| s.worst(|st| Some(st.max_von_mises)).map(|l| l.over_p_h));
+        let swt = range(&|s| Some(s.swt.value_pa));
         out.insert(
             format!("{material} / {surface}"),
             CurveSummary {
@@ -392,6 +511,9 @@ pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> 
                 mu_a_max: hi.mu_a.value,
                 mu_a_err_max: errs.map(|e| e.into_iter().fold(0.0, f64::max)),
                 resolved,
+                max_von_mises_over_p_h_range: vm.map(|v| v.0),
+                max_von_mises_worst_angle_deg: vm.map(|v| v.1),
+                swt_range_pa: swt.map(|v| v.0),
             },
         );
     }
@@ -409,7 +531,8 @@ struct Panel {
 /// material, one series per surface with markers at the computed angles
 /// and error bars where a ladder gave them, the flat surface in black; and,
 /// when a material's K_E was calibrated on its flat surface, a panel of
-/// K_E(ψ) (GPa) for those materials. The legend sits beside the panels.
+/// K_E(ψ) (GPa) for those materials; with `[stress]`, a panel per material
+/// of the largest von Mises stress over p_H. The legend sits beside the panels.
 pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
     let mut k_e = Panel {
@@ -462,8 +585,31 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
                 .insert(surface, e);
         }
     }
+    // With [stress]: the largest von Mises stress over p_H, per material.
+    let mut stress: BTreeMap<&str, Panel> = BTreeMap::new();
+    for ((material, surface), pts) in by_curve(points) {
+        let vm: Vec<(f64, f64, Option<f64>)> = pts
+            .iter()
+            .filter_map(|p| {
+                let l = p.stress.as_ref()?.worst(|st| Some(st.max_von_mises))?;
+                Some((p.key.angle_deg, l.over_p_h, None))
+            })
+            .collect();
+        if !vm.is_empty() {
+            stress
+                .entry(material)
+                .or_insert_with(|| Panel {
+                    title: format!("{material}: largest von Mises stress"),
+                    y_desc: "max von Mises / p_H (–)",
+                    series: BTreeMap::new(),
+                })
+                .series
+                .insert(surface, vm);
+        }
+    }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     panels.extend(energy.into_values());
+    panels.extend(stress.into_values());
     if !k_e.series.is_empty() {
         panels.push(k_e);
     }
@@ -691,6 +837,48 @@ pub fn write_result_fields(
     Ok(())
 }
 
+/// With `[stress]` and fields: the stress arrays and maps of a case under
+/// `fields/<case>/stress/` (the layout of `mpcontact solve`'s `stress/`),
+/// recomputed here from the returned tractions with the function the
+/// worker ran. A load history's turning states do not travel with the
+/// fields: for those (`stress.states = "turning"`) nothing is written and
+/// the returned note says so.
+pub fn write_stress_fields(
+    out_dir: &Path,
+    key: &CaseKey,
+    spec: &solver::CaseSpec,
+    cfg: &crate::config::StressCfg,
+    scalars: &CaseScalars,
+    (names, field_bytes): (&[String], &[u8]),
+) -> anyhow::Result<Option<String>> {
+    if spec.history.is_some() && cfg.states == "turning" {
+        return Ok(Some(format!(
+            "{key}: stress fields of a load history's turning states are not written by sweeps (its scalars are); `mpcontact solve` writes them"
+        )));
+    }
+    let n = spec.grid.n;
+    let get = |name: &str| -> anyhow::Result<Vec<f64>> {
+        let k = names
+            .iter()
+            .position(|f| f == name)
+            .ok_or_else(|| anyhow::anyhow!("no field {name}"))?;
+        Ok(protocol::read_field(field_bytes, k, n * n)
+            .ok_or_else(|| anyhow::anyhow!("field {name} missing"))?
+            .into_owned())
+    };
+    let fields = solver::Fields {
+        n,
+        p: get("p")?,
+        qx: get("qx")?,
+        qy: get("qy")?,
+        ..Default::default()
+    };
+    let so = crate::stress_out::compute(cfg, spec, scalars, &fields, &[])?;
+    let title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
+    let warnings = crate::stress_out::write(&fields_dir(out_dir, key), &so, &title)?;
+    Ok((!warnings.is_empty()).then(|| format!("{key}: {}", warnings.join("; "))))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -739,6 +927,7 @@ mod tests {
                 k_e: 1.0,
                 ..Default::default()
             }),
+            stress: None,
         }
     }
 

@@ -158,6 +158,7 @@ mod tests {
                 contact_radius_m: 1.0 / 3.0,
                 ..Default::default()
             }),
+            stress: None,
         }
     }
 
