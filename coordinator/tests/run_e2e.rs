@@ -1338,6 +1338,13 @@ angles_deg = [0, 90]
 
 /// The rows of a CSV as text, without `seconds`, `worker` and the columns
 /// in `drop`, keyed by the rows' `indenter` cell (`""` without that column).
+/// What `mpcontact check CONFIG` prints (it must succeed).
+fn check_text(config: &Path) -> String {
+    let check = Command::new(EXE).arg("check").arg(config).output().unwrap();
+    check_ok(&check, "check");
+    String::from_utf8_lossy(&check.stdout).into_owned()
+}
+
 fn rows_by_ball(path: &Path, drop: &[&str]) -> BTreeMap<String, Vec<String>> {
     let rows = read_csv(path);
     let header = &rows[0];
@@ -1433,13 +1440,7 @@ fn issue35_a_ball_axis_runs_every_ball_and_matches_the_one_ball_sweeps() {
     assert_eq!(journal_cases(&o).len(), 4);
     assert_eq!(self::summary(&o)["resumed"], 4);
     // `check` counts the balls and names each pair's kernel.
-    let check = Command::new(EXE)
-        .arg("check")
-        .arg(dir.join("sweep.toml"))
-        .output()
-        .unwrap();
-    check_ok(&check, "check");
-    let text = String::from_utf8_lossy(&check.stdout);
+    let text = check_text(&dir.join("sweep.toml"));
     assert!(
         text.contains("cases:     4 = 1 materials x 1 surfaces x 2 angles x 2 balls"),
         "{text}"
@@ -1647,13 +1648,7 @@ fn issue39_orientations_are_the_single_crystals_and_map_the_triangle() {
     assert!(!dir.join("axis/ipf/Cu/flat/mu_a.png").exists());
     // `check` counts the orientations and their kernels.
     std::fs::write(dir.join("sweep.toml"), ORIENT_CONFIG).unwrap();
-    let check = Command::new(EXE)
-        .arg("check")
-        .arg(dir.join("sweep.toml"))
-        .output()
-        .unwrap();
-    check_ok(&check, "check");
-    let text = String::from_utf8_lossy(&check.stdout);
+    let text = check_text(&dir.join("sweep.toml"));
     assert!(
         text.contains("cases:     6 = 1 materials x 3 orientations x 1 surfaces x 2 angles"),
         "{text}"
