@@ -321,4 +321,58 @@ mod tests {
         assert_eq!(every.min_side(), 1);
         assert!(!every.same(&two));
     }
+
+    /// The pieces of a cell list tile the field, each holding its cells; a
+    /// pass that writes its cells and sums them gives the same bits on 1, 2
+    /// and 3 threads: the pieces' sums, each over its cells in order, added
+    /// in piece order (and the plain serial sum to round-off).
+    #[test]
+    fn pieces_own_their_cells_and_sums_combine_in_piece_order_on_any_threads() {
+        let len = 10_000;
+        let cells: Vec<usize> = (0..len).filter(|i| i % 3 != 1).collect();
+        let chunks = Chunks::of_cells(&cells, len);
+        assert_eq!(chunks.count(), cells.len().div_ceil(CHUNK));
+        assert!(chunks.count() > 3, "several pieces");
+        let (mut next, mut seen) = (0, 0);
+        for part in chunks.parts() {
+            assert_eq!(part.range().start, next);
+            next = part.range().end;
+            assert!(part.list().iter().all(|c| part.range().contains(c)));
+            seen += part.list().len();
+        }
+        assert_eq!((next, seen), (len, cells.len()));
+        let flat = Chunks::flat(len);
+        assert_eq!(flat.count(), len.div_ceil(CHUNK));
+        assert!(flat
+            .parts()
+            .all(|p| p.list().is_empty() && p.range().len() <= CHUNK));
+
+        let values: Vec<f64> = (0..len).map(|i| 1.0 / (1.0 + i as f64)).collect();
+        let mut expect = 0.0;
+        for part in chunks.parts() {
+            let mut s = 0.0;
+            for &c in part.list() {
+                s += values[c];
+            }
+            expect += s;
+        }
+        let serial: f64 = cells.iter().map(|&c| values[c]).sum();
+        assert!((expect - serial).abs() < 1e-14 * serial);
+        for t in [1, 2, 3] {
+            let threads = Threads::new(t).unwrap().at_every_size();
+            let mut out = vec![0.0; len];
+            let parts = threads.chunked(&chunks, chunks.with(&mut out), |(part, out)| {
+                let mut s = 0.0;
+                for &c in part.list() {
+                    out[c - part.start] = values[c];
+                    s += values[c];
+                }
+                s
+            });
+            let total = parts.into_iter().fold(0.0, |a, b| a + b);
+            assert_eq!(total.to_bits(), expect.to_bits(), "{t} threads");
+            assert!(cells.iter().all(|&c| out[c] == values[c]));
+            assert_eq!(out.iter().filter(|&&v| v != 0.0).count(), cells.len());
+        }
+    }
 }
