@@ -13,7 +13,7 @@
 
 use crate::fft2::{ensure_len, Fft2};
 use crate::grid::Grid;
-use crate::parallel::Threads;
+use crate::parallel::{Chunks, Threads};
 use num_complex::Complex64;
 
 /// Fourier preconditioner of the normal iteration: `z = Π W Π g` with `W` the
@@ -70,13 +70,14 @@ impl FourierPrecond {
     pub fn apply(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
         ensure_len(&mut self.spec, self.fft.spectrum_len());
         z.copy_from_slice(g);
-        centre_on(active, z);
+        let threads = self.fft.threads();
+        centre_on(threads, active, z);
         self.fft.forward_padded(z, &mut self.spec);
         for (v, w) in self.spec.iter_mut().zip(&self.symbol) {
             *v *= *w;
         }
         self.fft.inverse_cropped(&mut self.spec, z);
-        centre_on(active, z);
+        centre_on(self.fft.threads(), active, z);
     }
 
     /// Frees the work spectrum until the next application: a normal solve
@@ -86,19 +87,33 @@ impl FourierPrecond {
     }
 }
 
-/// `Π` in place: `v − mean_active(v)` on the active cells, zero elsewhere.
-fn centre_on(active: &[bool], v: &mut [f64]) {
-    let (mut s, mut c) = (0.0, 0usize);
-    for (x, &a) in v.iter().zip(active) {
-        if a {
-            s += x;
-            c += 1;
+/// `Π` in place: `v − mean_active(v)` on the active cells, zero elsewhere
+/// (the mean summed over fixed pieces, see [`crate::parallel`]).
+fn centre_on(threads: &Threads, active: &[bool], v: &mut [f64]) {
+    let len = v.len();
+    let chunks = Chunks::flat(len);
+    let parts = threads.chunked(&chunks, chunks.items(), |part| {
+        let (mut s, mut c) = (0.0, 0usize);
+        for i in part.range() {
+            if active[i] {
+                s += v[i];
+                c += 1;
+            }
         }
+        (s, c)
+    });
+    let (mut s, mut c) = (0.0, 0usize);
+    for (ps, pc) in parts {
+        s += ps;
+        c += pc;
     }
     let mean = if c > 0 { s / c as f64 } else { 0.0 };
-    for (x, &a) in v.iter_mut().zip(active) {
-        *x = if a { *x - mean } else { 0.0 };
-    }
+    threads.chunked(&chunks, chunks.with(v), |(part, v)| {
+        for i in part.range() {
+            let x = &mut v[i - part.start];
+            *x = if active[i] { *x - mean } else { 0.0 };
+        }
+    });
 }
 
 /// Smallest grid that is still coarsened further.
@@ -141,6 +156,11 @@ impl CoarseLevel {
     pub fn set_threads(&mut self, threads: &Threads) {
         self.fft.set_threads(threads);
         self.precond.set_threads(threads);
+    }
+
+    /// The threads of this level's transforms.
+    pub fn threads(&self) -> &Threads {
+        self.fft.threads()
     }
 
     /// The Fourier preconditioner of this level.

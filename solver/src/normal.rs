@@ -8,7 +8,7 @@
 use crate::error::SolverError;
 use crate::multilevel::{coarse_levels, prolong, restrict, CoarseLevel, FourierPrecond};
 use crate::operator::{Operator, Z};
-use crate::parallel::Threads;
+use crate::parallel::{Chunks, Threads};
 
 /// Convergence report of one normal solve.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -48,6 +48,8 @@ pub struct NormalSolution {
 /// What the Polonsky–Keer iteration needs of an operator: `uz = K_zz * p`,
 /// and the Fourier preconditioner of its grid.
 trait ZzApply {
+    /// The threads of the grid's transforms, which the vector passes share.
+    fn threads(&self) -> Threads;
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]);
     fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]);
 }
@@ -62,6 +64,9 @@ struct Fine<'a> {
 }
 
 impl ZzApply for Fine<'_> {
+    fn threads(&self) -> Threads {
+        self.op.threads().clone()
+    }
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
         self.op.normal(p, uz);
     }
@@ -89,6 +94,9 @@ impl ZzApply for Fine<'_> {
 }
 
 impl ZzApply for CoarseLevel {
+    fn threads(&self) -> Threads {
+        CoarseLevel::threads(self).clone()
+    }
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
         self.normal(p, uz);
     }
@@ -201,6 +209,8 @@ fn polonsky_keer(
         precondition,
     } = *level;
     let len = h.len();
+    let threads = op.threads();
+    let chunks = Chunks::flat(len);
     let sum: f64 = p.iter().sum::<f64>() * da;
     if sum <= 0.0 || !sum.is_finite() {
         p.copy_from_slice(&default_start(h));
@@ -233,14 +243,24 @@ fn polonsky_keer(
             since_refresh = 0;
         }
         since_refresh += 1;
-        let mut nc = 0usize;
-        let mut sum_g = 0.0;
-        for i in 0..len {
-            g[i] = u[i] + h[i];
-            if p[i] > 0.0 {
-                nc += 1;
-                sum_g += g[i];
+        // Every sum below is over the fixed pieces of `chunks`, combined in
+        // their order (see `crate::parallel`): the same bits on any threads.
+        let parts = threads.chunked(&chunks, chunks.with(&mut g), |(part, g)| {
+            let (mut nc, mut s) = (0usize, 0.0);
+            for i in part.range() {
+                let gi = u[i] + h[i];
+                g[i - part.start] = gi;
+                if p[i] > 0.0 {
+                    nc += 1;
+                    s += gi;
+                }
             }
+            (nc, s)
+        });
+        let (mut nc, mut sum_g) = (0usize, 0.0);
+        for (c, s) in parts {
+            nc += c;
+            sum_g += s;
         }
         if nc == 0 {
             break;
@@ -249,27 +269,38 @@ fn polonsky_keer(
         // Search direction: the (preconditioned) residual on the contact cells,
         // conjugated with the previous direction unless the set changed.
         let gg = if precondition {
-            for i in 0..len {
-                g[i] -= gbar;
-                active[i] = p[i] > 0.0;
-            }
+            let items = chunks.with2(&mut g, &mut active);
+            threads.chunked(&chunks, items, |(part, g, active)| {
+                for i in part.range() {
+                    let k = i - part.start;
+                    g[k] -= gbar;
+                    active[k] = p[i] > 0.0;
+                }
+            });
             op.precondition(&g, &active, &mut z);
-            let mut gz = 0.0;
-            for i in 0..len {
-                if active[i] {
-                    gz += g[i] * z[i];
+            let parts = threads.chunked(&chunks, chunks.items(), |part| {
+                let mut gz = 0.0;
+                for i in part.range() {
+                    if active[i] {
+                        gz += g[i] * z[i];
+                    }
                 }
-            }
-            gz
+                gz
+            });
+            parts.into_iter().fold(0.0, |a, b| a + b)
         } else {
-            let mut gg = 0.0;
-            for i in 0..len {
-                g[i] -= gbar;
-                if p[i] > 0.0 {
-                    gg += g[i] * g[i];
+            let parts = threads.chunked(&chunks, chunks.with(&mut g), |(part, g)| {
+                let mut gg = 0.0;
+                for i in part.range() {
+                    let gi = &mut g[i - part.start];
+                    *gi -= gbar;
+                    if p[i] > 0.0 {
+                        gg += *gi * *gi;
+                    }
                 }
-            }
-            gg
+                gg
+            });
+            parts.into_iter().fold(0.0, |a, b| a + b)
         };
         if gg == 0.0 {
             // The contact cells' gaps are equal to the bit: the set is
@@ -290,58 +321,83 @@ fn polonsky_keer(
             break;
         }
         let zdir: &[f64] = if precondition { &z } else { &g };
-        for i in 0..len {
-            t[i] = if p[i] > 0.0 {
-                zdir[i] + delta * (gg / g_old) * t[i]
-            } else {
-                0.0
-            };
-        }
+        let beta = delta * (gg / g_old);
+        threads.chunked(&chunks, chunks.with(&mut t), |(part, t)| {
+            for i in part.range() {
+                let ti = &mut t[i - part.start];
+                *ti = if p[i] > 0.0 {
+                    zdir[i] + beta * *ti
+                } else {
+                    0.0
+                };
+            }
+        });
         g_old = gg;
         op.apply_zz(&t, &mut r);
         report.applications += 1;
-        let (mut sr, mut num) = (0.0, 0.0);
-        for i in 0..len {
-            if p[i] > 0.0 {
-                sr += r[i];
-                num += g[i] * t[i];
+        let parts = threads.chunked(&chunks, chunks.items(), |part| {
+            let (mut sr, mut num) = (0.0, 0.0);
+            for i in part.range() {
+                if p[i] > 0.0 {
+                    sr += r[i];
+                    num += g[i] * t[i];
+                }
             }
+            (sr, num)
+        });
+        let (mut sr, mut num) = (0.0, 0.0);
+        for (a, b) in parts {
+            sr += a;
+            num += b;
         }
         let rbar = sr / nc as f64;
-        let mut den = 0.0;
-        for i in 0..len {
-            if p[i] > 0.0 {
-                den += (r[i] - rbar) * t[i];
+        let parts = threads.chunked(&chunks, chunks.items(), |part| {
+            let mut den = 0.0;
+            for i in part.range() {
+                if p[i] > 0.0 {
+                    den += (r[i] - rbar) * t[i];
+                }
             }
-        }
+            den
+        });
+        let den = parts.into_iter().fold(0.0, |a, b| a + b);
         if den <= 0.0 || !den.is_finite() {
             break;
         }
         let tau = num / den;
         // Step, clip, and re-admit cells that interpenetrate (overlap set).
-        let mut overlap = false;
-        let mut clipped = false;
-        let mut total = 0.0;
-        for i in 0..len {
-            let old = p[i];
-            p_old[i] = old;
-            let mut new = if old > 0.0 {
-                let v = old - tau * t[i];
-                if v < 0.0 {
-                    clipped = true;
-                    0.0
+        let items = chunks.with2(p, &mut p_old);
+        let parts = threads.chunked(&chunks, items, |(part, p, p_old)| {
+            let (mut overlap, mut clipped, mut total) = (false, false, 0.0);
+            for i in part.range() {
+                let k = i - part.start;
+                let old = p[k];
+                p_old[k] = old;
+                let mut new = if old > 0.0 {
+                    let v = old - tau * t[i];
+                    if v < 0.0 {
+                        clipped = true;
+                        0.0
+                    } else {
+                        v
+                    }
                 } else {
-                    v
+                    0.0
+                };
+                if new == 0.0 && g[i] < 0.0 {
+                    new = -tau * g[i];
+                    overlap = true;
                 }
-            } else {
-                0.0
-            };
-            if new == 0.0 && g[i] < 0.0 {
-                new = -tau * g[i];
-                overlap = true;
+                p[k] = new;
+                total += new;
             }
-            p[i] = new;
-            total += new;
+            (overlap, clipped, total)
+        });
+        let (mut overlap, mut clipped, mut total) = (false, false, 0.0);
+        for (o, c, s) in parts {
+            overlap |= o;
+            clipped |= c;
+            total += s;
         }
         delta = if overlap { 0.0 } else { 1.0 };
         let total = total * da;
@@ -352,16 +408,22 @@ fn polonsky_keer(
             ));
         }
         let scale = load_n / total;
-        let mut change = 0.0;
         // u = K p follows the step unless the set changed by clipping or overlap.
         u_valid = !(clipped || overlap);
-        for i in 0..len {
-            p[i] *= scale;
-            change += (p[i] - p_old[i]).abs();
-            if u_valid {
-                u[i] = scale * (u[i] - tau * r[i]);
+        let items = chunks.with2(p, u);
+        let parts = threads.chunked(&chunks, items, |(part, p, u)| {
+            let mut change = 0.0;
+            for i in part.range() {
+                let k = i - part.start;
+                p[k] *= scale;
+                change += (p[k] - p_old[i]).abs();
+                if u_valid {
+                    u[k] = scale * (u[k] - tau * r[i]);
+                }
             }
-        }
+            change
+        });
+        let change = parts.into_iter().fold(0.0, |a, b| a + b);
         report.change = change * da / load_n;
         if report.change < tolerance {
             report.converged = true;

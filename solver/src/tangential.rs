@@ -21,7 +21,7 @@ use crate::error::SolverError;
 use crate::fista::{self, Momentum};
 use crate::multilevel::FourierPrecond;
 use crate::operator::Operator;
-use crate::parallel::Threads;
+use crate::parallel::{Chunks, Threads};
 pub use crate::tangential_problem::{
     TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
 };
@@ -55,6 +55,10 @@ fn slip_field(
 struct Feasible<'a> {
     /// The contact cells.
     cells: &'a [usize],
+    /// Their fixed pieces, on which every pass over them runs, and the
+    /// threads those passes may use (see [`crate::parallel`]).
+    chunks: &'a Chunks<'a>,
+    threads: &'a Threads,
     /// Pressure per cell, Pa: the friction bound is [`Feasible::bound`].
     p: &'a [f64],
     /// Friction coefficient.
@@ -66,17 +70,32 @@ struct Feasible<'a> {
 }
 
 impl<'a> Feasible<'a> {
-    /// The set of the contact cells `cells` of the pressure `p`.
-    fn new(cells: &'a [usize], p: &'a [f64], mu: f64, target: [f64; 2]) -> Self {
+    /// The set of the contact cells of `chunks` of the pressure `p`.
+    fn new(
+        (chunks, threads): (&'a Chunks<'a>, &'a Threads),
+        cells: &'a [usize],
+        p: &'a [f64],
+        mu: f64,
+        target: [f64; 2],
+    ) -> Self {
         let mut set = Feasible {
             cells,
+            chunks,
+            threads,
             p,
             mu,
             cap: 0.0,
             target,
         };
         // Σ b_i over the contact cells: the largest force the discs can carry.
-        set.cap = cells.iter().map(|&i| set.bound(i)).sum();
+        let parts = threads.chunked(chunks, chunks.items(), |part| {
+            let mut s = 0.0;
+            for &i in part.list() {
+                s += set.bound(i);
+            }
+            s
+        });
+        set.cap = parts.into_iter().fold(0.0, |a, b| a + b);
         set
     }
 
@@ -97,7 +116,12 @@ fn project(
     (qx, qy): (&mut [f64], &mut [f64]),
 ) -> Option<()> {
     let Feasible {
-        cells, cap, target, ..
+        cells,
+        chunks,
+        threads,
+        cap,
+        target,
+        ..
     } = *set;
     let tnorm = target[0].hypot(target[1]);
     if tnorm >= cap {
@@ -106,28 +130,40 @@ fn project(
     let tol = 1e-14 * cap;
     let mut l = *lambda;
     let eval = |l: [f64; 2], qx: &mut [f64], qy: &mut [f64]| {
+        let parts = threads.chunked(chunks, chunks.with2(qx, qy), |(part, qx, qy)| {
+            let (mut f, mut j) = ([0.0; 2], [0.0; 3]);
+            for &i in part.list() {
+                let k = i - part.start;
+                let (wx, wy) = (zx[i] + l[0], zy[i] + l[1]);
+                let w = norm(wx, wy);
+                let b = set.bound(i);
+                if w <= b {
+                    qx[k] = wx;
+                    qy[k] = wy;
+                    j[0] += 1.0;
+                    j[2] += 1.0;
+                } else {
+                    let s = b / w;
+                    let (nx, ny) = (wx / w, wy / w);
+                    qx[k] = s * wx;
+                    qy[k] = s * wy;
+                    j[0] += s * (1.0 - nx * nx);
+                    j[1] -= s * nx * ny;
+                    j[2] += s * (1.0 - ny * ny);
+                }
+                f[0] += qx[k];
+                f[1] += qy[k];
+            }
+            (f, j)
+        });
         let mut f = [-target[0], -target[1]];
         let mut j = [[0.0; 2]; 2];
-        for &i in cells {
-            let (wx, wy) = (zx[i] + l[0], zy[i] + l[1]);
-            let w = norm(wx, wy);
-            let b = set.bound(i);
-            if w <= b {
-                qx[i] = wx;
-                qy[i] = wy;
-                j[0][0] += 1.0;
-                j[1][1] += 1.0;
-            } else {
-                let s = b / w;
-                let (nx, ny) = (wx / w, wy / w);
-                qx[i] = s * wx;
-                qy[i] = s * wy;
-                j[0][0] += s * (1.0 - nx * nx);
-                j[0][1] -= s * nx * ny;
-                j[1][1] += s * (1.0 - ny * ny);
-            }
-            f[0] += qx[i];
-            f[1] += qy[i];
+        for (pf, pj) in parts {
+            f[0] += pf[0];
+            f[1] += pf[1];
+            j[0][0] += pj[0];
+            j[0][1] += pj[1];
+            j[1][1] += pj[2];
         }
         j[1][0] = j[0][1];
         (f, j)
@@ -314,7 +350,9 @@ fn on_grid_taking(
         });
     }
     let target = [prob.force[0] / da, prob.force[1] / da];
-    let set = Feasible::new(&cells, p, mu, target);
+    let threads = op.threads().clone();
+    let chunks = Chunks::of_cells(&cells, len);
+    let set = Feasible::new((&chunks, &threads), &cells, p, mu, target);
     let (mut qx, mut qy) = (vec![0.0; len], vec![0.0; len]);
     let (mut zx, mut zy) = match handed {
         Some((zx, zy)) => {
@@ -443,14 +481,24 @@ fn on_grid_taking(
     if !(cg.converged && fista_budget == 0) {
         slip_field(op, prob.extra, (&qx, &qy), (&mut sx, &mut sy));
     }
-    let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
-    for &i in &cells {
-        stick[i] = qx[i].hypot(qy[i]) < stick_tol * set.bound(i);
-        if stick[i] {
-            mx += sx[i];
-            my += sy[i];
-            nst += 1;
+    let parts = threads.chunked(&chunks, chunks.with(&mut stick), |(part, stick)| {
+        let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
+        for &i in part.list() {
+            let sticks = qx[i].hypot(qy[i]) < stick_tol * set.bound(i);
+            stick[i - part.start] = sticks;
+            if sticks {
+                mx += sx[i];
+                my += sy[i];
+                nst += 1;
+            }
         }
+        (mx, my, nst)
+    });
+    let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
+    for (x, y, c) in parts {
+        mx += x;
+        my += y;
+        nst += c;
     }
     if nst > 0 {
         shift = [mx / nst as f64, my / nst as f64];
@@ -459,28 +507,41 @@ fn on_grid_taking(
         .hypot(shift[1])
         .max(prob.slip_floor)
         .max(f64::MIN_POSITIVE);
+    let flat = Chunks::flat(len);
+    let parts = threads.chunked(&flat, flat.with2(&mut sx, &mut sy), |(part, sx, sy)| {
+        let (mut st_res, mut sl_res) = (0.0_f64, 0.0_f64);
+        let (mut fx, mut fy) = (0.0, 0.0);
+        for i in part.range() {
+            let k = i - part.start;
+            fx += qx[i];
+            fy += qy[i];
+            if p[i] <= 0.0 {
+                sx[k] = 0.0;
+                sy[k] = 0.0;
+                continue;
+            }
+            let (wx, wy) = (sx[k] - shift[0], sy[k] - shift[1]);
+            if stick[i] {
+                st_res = st_res.max(wx.hypot(wy) / scale);
+                sx[k] = 0.0;
+                sy[k] = 0.0;
+            } else {
+                let qn = qx[i].hypot(qy[i]);
+                let w = wx.hypot(wy);
+                sl_res = sl_res.max((wx + w * qx[i] / qn).hypot(wy + w * qy[i] / qn) / scale);
+                sx[k] = wx;
+                sy[k] = wy;
+            }
+        }
+        (st_res, sl_res, fx, fy)
+    });
     let (mut st_res, mut sl_res) = (0.0_f64, 0.0_f64);
     let (mut fx, mut fy) = (0.0, 0.0);
-    for i in 0..len {
-        fx += qx[i];
-        fy += qy[i];
-        if p[i] <= 0.0 {
-            sx[i] = 0.0;
-            sy[i] = 0.0;
-            continue;
-        }
-        let (wx, wy) = (sx[i] - shift[0], sy[i] - shift[1]);
-        if stick[i] {
-            st_res = st_res.max(wx.hypot(wy) / scale);
-            sx[i] = 0.0;
-            sy[i] = 0.0;
-        } else {
-            let qn = qx[i].hypot(qy[i]);
-            let w = wx.hypot(wy);
-            sl_res = sl_res.max((wx + w * qx[i] / qn).hypot(wy + w * qy[i] / qn) / scale);
-            sx[i] = wx;
-            sy[i] = wy;
-        }
+    for (st, sl, x, y) in parts {
+        st_res = st_res.max(st);
+        sl_res = sl_res.max(sl);
+        fx += x;
+        fy += y;
     }
     report.stick_residual = st_res;
     report.slip_residual = sl_res;
@@ -566,7 +627,7 @@ fn cg_disc(
     (zx, zy): (&mut [f64], &mut [f64]),
     lambda: &mut [f64; 2],
 ) -> Result<CgOutcome, SolverError> {
-    let cells = set.cells;
+    let (cells, chunks, threads) = (set.cells, set.chunks, set.threads);
     let bound = |i: usize| set.bound(i);
     let len = qx.len();
     let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
@@ -584,9 +645,9 @@ fn cg_disc(
     for &i in cells {
         stick[i] = !on_bound(qx[i], qy[i], bound(i));
     }
-    // This iteration's `SlipCell` of each slip cell, in the order of `cells`
-    // (the later passes of an iteration walk `cells` in the same order).
-    let mut rims: Vec<SlipCell> = Vec::new();
+    // This iteration's `SlipCell` of each slip cell, per piece of `chunks`
+    // in the order of its cells (the later passes walk them in that order).
+    let mut rims: Vec<Vec<SlipCell>> = (0..chunks.count()).map(|_| Vec::new()).collect();
     let mut rz_old = 1.0;
     let mut conj = false;
     // The slip field in (ux, uy) is exact (`fresh`) or updated since `age` moves.
@@ -612,14 +673,24 @@ fn cg_disc(
             fresh = true;
             age = 0;
         }
-        // The mean slip over the stick set (the rigid shift δt).
-        let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
-        for &i in cells {
-            if stick[i] {
-                mx += ux[i];
-                my += uy[i];
-                ns += 1;
+        // The mean slip over the stick set (the rigid shift δt). Every sum
+        // below is over the pieces of `chunks`, combined in their order.
+        let parts = threads.chunked(chunks, chunks.items(), |part| {
+            let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
+            for &i in part.list() {
+                if stick[i] {
+                    mx += ux[i];
+                    my += uy[i];
+                    ns += 1;
+                }
             }
+            (mx, my, ns)
+        });
+        let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
+        for (x, y, c) in parts {
+            mx += x;
+            my += y;
+            ns += c;
         }
         if ns == 0 {
             // Every cell slips: not a partial-slip state; let FISTA take over.
@@ -629,12 +700,14 @@ fn cg_disc(
         out.shift = d;
         // The preconditioned stick residual, less its mean mode: Π W Π u.
         let alpha = pre.prepare(&stick, ns, op.grid(), (ux, uy));
+        let sz = pre.view();
         // A slip cell's traction direction n, tangent t, rim curvature c and
         // Jacobi weight k (0: aligned by its own gradient step).
+        let (q, u) = ((&*qx, &*qy), (&*ux, &*uy));
         let rim = |i: usize| -> SlipCell {
-            let qn = norm(qx[i], qy[i]);
-            let n = [qx[i] / qn, qy[i] / qn];
-            let press = -((ux[i] - d[0]) * n[0] + (uy[i] - d[1]) * n[1]);
+            let qn = norm(q.0[i], q.1[i]);
+            let n = [q.0[i] / qn, q.1[i] / qn];
+            let press = -((u.0[i] - d[0]) * n[0] + (u.1[i] - d[1]) * n[1]);
             let c = press.max(0.0) / bound(i);
             let k = if c > STIFF_RIM * stiffness {
                 0.0
@@ -646,32 +719,46 @@ fn cg_disc(
         // KKT residual relative to |δt|; the weighted Gram matrix of the force
         // constraint, A M⁻¹ Aᵀ = α n_stick I + Σ_slip k t tᵀ, and A M⁻¹ u.
         let scale = d[0].hypot(d[1]).max(prob.slip_floor).max(f64::MIN_POSITIVE);
-        let (mut kkt_stick, mut kkt_slip) = (0.0_f64, 0.0_f64);
+        let items: Vec<_> = chunks.parts().zip(rims.iter_mut()).collect();
+        let parts = threads.chunked(chunks, items, |(part, rims)| {
+            let (mut kkt_stick, mut kkt_slip) = (0.0_f64, 0.0_f64);
+            let (mut gram, mut rhs) = ([0.0; 3], [0.0; 2]);
+            rims.clear();
+            for &i in part.list() {
+                let (wx, wy) = (u.0[i] - d[0], u.1[i] - d[1]);
+                if stick[i] {
+                    kkt_stick = kkt_stick.max(norm(wx, wy));
+                    rhs[0] += alpha * u.0[i];
+                    rhs[1] += alpha * u.1[i];
+                } else {
+                    let cell = rim(i);
+                    let (n, t, k) = (cell.n, cell.t(), cell.k);
+                    let w = norm(wx, wy);
+                    kkt_slip = kkt_slip.max(norm(wx + w * n[0], wy + w * n[1]));
+                    gram[0] += k * t[0] * t[0];
+                    gram[1] += k * t[0] * t[1];
+                    gram[2] += k * t[1] * t[1];
+                    let rt = k * (t[0] * u.0[i] + t[1] * u.1[i]);
+                    rhs[0] += t[0] * rt;
+                    rhs[1] += t[1] * rt;
+                    rims.push(cell);
+                }
+            }
+            (kkt_stick.max(kkt_slip), gram, rhs)
+        });
+        let mut kkt = 0.0_f64;
         let mut gram = [[alpha * ns as f64, 0.0], [0.0, alpha * ns as f64]];
         let mut rhs = [0.0; 2];
-        rims.clear();
-        for &i in cells {
-            let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
-            if stick[i] {
-                kkt_stick = kkt_stick.max(norm(wx, wy));
-                rhs[0] += alpha * ux[i];
-                rhs[1] += alpha * uy[i];
-            } else {
-                let cell = rim(i);
-                let (n, t, k) = (cell.n, cell.t(), cell.k);
-                let w = norm(wx, wy);
-                kkt_slip = kkt_slip.max(norm(wx + w * n[0], wy + w * n[1]));
-                gram[0][0] += k * t[0] * t[0];
-                gram[0][1] += k * t[0] * t[1];
-                gram[1][1] += k * t[1] * t[1];
-                let rt = k * (t[0] * ux[i] + t[1] * uy[i]);
-                rhs[0] += t[0] * rt;
-                rhs[1] += t[1] * rt;
-                rims.push(cell);
-            }
+        for (k, g, r) in parts {
+            kkt = kkt.max(k);
+            gram[0][0] += g[0];
+            gram[0][1] += g[1];
+            gram[1][1] += g[2];
+            rhs[0] += r[0];
+            rhs[1] += r[1];
         }
         gram[1][0] = gram[0][1];
-        out.kkt = kkt_stick.max(kkt_slip) / scale;
+        out.kkt = kkt / scale;
 
         if out.kkt < prob.tolerance {
             if fresh {
@@ -703,67 +790,100 @@ fn cg_disc(
         // constraint again, as the tangents turned a little since.
         // On stick cells z = P (u − d) + α (d − m).
         let zm = [alpha * (d[0] - m[0]), alpha * (d[1] - m[1])];
-        let mut rz = 0.0;
-        let mut slip = rims.iter();
-        for &i in cells {
-            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
-            if stick[i] {
-                let z = pre.stick_z(i, [rx, ry], zm);
-                rz += rx * z[0] + ry * z[1];
-            } else {
-                let cell = slip.next().expect("one per slip cell");
-                let (t, k) = (cell.t(), cell.k);
-                let rt = t[0] * rx + t[1] * ry;
-                rz += k * rt * rt;
+        let items: Vec<_> = chunks.parts().zip(rims.iter()).collect();
+        let parts = threads.chunked(chunks, items, |(part, rims)| {
+            let mut rz = 0.0;
+            let mut slip = rims.iter();
+            for &i in part.list() {
+                let (rx, ry) = (u.0[i] - m[0], u.1[i] - m[1]);
+                if stick[i] {
+                    let z = sz.at(i, [rx, ry], zm);
+                    rz += rx * z[0] + ry * z[1];
+                } else {
+                    let cell = slip.next().expect("one per slip cell");
+                    let (t, k) = (cell.t(), cell.k);
+                    let rt = t[0] * rx + t[1] * ry;
+                    rz += k * rt * rt;
+                }
             }
-        }
+            rz
+        });
+        let rz = parts.into_iter().fold(0.0, |a, b| a + b);
         let beta = if conj { rz / rz_old } else { 0.0 };
         rz_old = rz;
-        let mut rhs = [0.0; 2];
-        let mut slip = rims.iter();
-        for &i in cells {
-            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
-            if stick[i] {
-                let z = pre.stick_z(i, [rx, ry], zm);
-                vx[i] = z[0] + beta * vx[i];
-                vy[i] = z[1] + beta * vy[i];
-                rhs[0] += vx[i];
-                rhs[1] += vy[i];
-            } else {
-                let cell = slip.next().expect("one per slip cell");
-                let (t, k) = (cell.t(), cell.k);
-                let s = if k > 0.0 {
-                    k * (t[0] * rx + t[1] * ry) + beta * (t[0] * vx[i] + t[1] * vy[i])
+        let items: Vec<_> = chunks
+            .with2(&mut vx, &mut vy)
+            .into_iter()
+            .zip(rims.iter())
+            .collect();
+        let parts = threads.chunked(chunks, items, |((part, vx, vy), rims)| {
+            let mut rhs = [0.0; 2];
+            let mut slip = rims.iter();
+            for &i in part.list() {
+                let j = i - part.start;
+                let (rx, ry) = (u.0[i] - m[0], u.1[i] - m[1]);
+                if stick[i] {
+                    let z = sz.at(i, [rx, ry], zm);
+                    vx[j] = z[0] + beta * vx[j];
+                    vy[j] = z[1] + beta * vy[j];
+                    rhs[0] += vx[j];
+                    rhs[1] += vy[j];
                 } else {
-                    0.0
-                };
-                vx[i] = s * t[0];
-                vy[i] = s * t[1];
-                rhs[0] += t[0] * s;
-                rhs[1] += t[1] * s;
+                    let cell = slip.next().expect("one per slip cell");
+                    let (t, k) = (cell.t(), cell.k);
+                    let s = if k > 0.0 {
+                        k * (t[0] * rx + t[1] * ry) + beta * (t[0] * vx[j] + t[1] * vy[j])
+                    } else {
+                        0.0
+                    };
+                    vx[j] = s * t[0];
+                    vy[j] = s * t[1];
+                    rhs[0] += t[0] * s;
+                    rhs[1] += t[1] * s;
+                }
             }
+            rhs
+        });
+        let mut rhs = [0.0; 2];
+        for r in parts {
+            rhs[0] += r[0];
+            rhs[1] += r[1];
         }
         // v −= M⁻¹ Aᵀ m2 with A M⁻¹ Aᵀ m2 = A v, so that A v = 0.
         let Some(m2) = solve2(gram, rhs) else {
             return Ok(out);
         };
-        let (mut num, mut bend) = (0.0, 0.0);
-        let mut slip = rims.iter();
-        for &i in cells {
-            let (rx, ry) = (ux[i] - m[0], uy[i] - m[1]);
-            if stick[i] {
-                vx[i] -= alpha * m2[0];
-                vy[i] -= alpha * m2[1];
-                num += rx * vx[i] + ry * vy[i];
-            } else {
-                let cell = slip.next().expect("one per slip cell");
-                let (t, c, k) = (cell.t(), cell.c, cell.k);
-                let s = t[0] * vx[i] + t[1] * vy[i] - k * (t[0] * m2[0] + t[1] * m2[1]);
-                vx[i] = s * t[0];
-                vy[i] = s * t[1];
-                num += (t[0] * rx + t[1] * ry) * s;
-                bend += c * s * s;
+        let items: Vec<_> = chunks
+            .with2(&mut vx, &mut vy)
+            .into_iter()
+            .zip(rims.iter())
+            .collect();
+        let parts = threads.chunked(chunks, items, |((part, vx, vy), rims)| {
+            let (mut num, mut bend) = (0.0, 0.0);
+            let mut slip = rims.iter();
+            for &i in part.list() {
+                let j = i - part.start;
+                let (rx, ry) = (u.0[i] - m[0], u.1[i] - m[1]);
+                if stick[i] {
+                    vx[j] -= alpha * m2[0];
+                    vy[j] -= alpha * m2[1];
+                    num += rx * vx[j] + ry * vy[j];
+                } else {
+                    let cell = slip.next().expect("one per slip cell");
+                    let (t, c, k) = (cell.t(), cell.c, cell.k);
+                    let s = t[0] * vx[j] + t[1] * vy[j] - k * (t[0] * m2[0] + t[1] * m2[1]);
+                    vx[j] = s * t[0];
+                    vy[j] = s * t[1];
+                    num += (t[0] * rx + t[1] * ry) * s;
+                    bend += c * s * s;
+                }
             }
+            (num, bend)
+        });
+        let (mut num, mut bend) = (0.0, 0.0);
+        for (a, b) in parts {
+            num += a;
+            bend += b;
         }
         if num <= 0.0 {
             // Not a descent direction: the old direction no longer conjugate
@@ -784,28 +904,39 @@ fn cg_disc(
         // conjugate directions the projected-gradient step, and on slip cells
         // whose slip runs along their traction the inward gradient step that
         // releases them. Δq holds the current tractions until the projection.
-        let mut slip = rims.iter();
-        for &i in cells {
-            dqx[i] = qx[i];
-            dqy[i] = qy[i];
-            zx[i] = qx[i] - tau * vx[i];
-            zy[i] = qy[i] - tau * vy[i];
-            if !stick[i] {
-                let cell = slip.next().expect("one per slip cell");
-                let (n, k) = (cell.n, cell.k);
-                let (wx, wy) = (ux[i] - d[0], uy[i] - d[1]);
-                if k == 0.0 {
-                    zx[i] = qx[i] - tau * wx;
-                    zy[i] = qy[i] - tau * wy;
-                } else {
-                    let along = wx * n[0] + wy * n[1];
-                    if along > 0.0 {
-                        zx[i] -= tau * along * n[0];
-                        zy[i] -= tau * along * n[1];
+        let (v, u) = ((&vx, &vy), (&*ux, &*uy));
+        let items: Vec<_> = chunks
+            .with2(&mut dqx, &mut dqy)
+            .into_iter()
+            .zip(chunks.split(zx))
+            .zip(chunks.split(zy))
+            .zip(rims.iter())
+            .collect();
+        threads.chunked(chunks, items, |((((part, dqx, dqy), zx), zy), rims)| {
+            let mut slip = rims.iter();
+            for &i in part.list() {
+                let j = i - part.start;
+                dqx[j] = q.0[i];
+                dqy[j] = q.1[i];
+                zx[j] = q.0[i] - tau * v.0[i];
+                zy[j] = q.1[i] - tau * v.1[i];
+                if !stick[i] {
+                    let cell = slip.next().expect("one per slip cell");
+                    let (n, k) = (cell.n, cell.k);
+                    let (wx, wy) = (u.0[i] - d[0], u.1[i] - d[1]);
+                    if k == 0.0 {
+                        zx[j] = q.0[i] - tau * wx;
+                        zy[j] = q.1[i] - tau * wy;
+                    } else {
+                        let along = wx * n[0] + wy * n[1];
+                        if along > 0.0 {
+                            zx[j] -= tau * along * n[0];
+                            zy[j] -= tau * along * n[1];
+                        }
                     }
                 }
             }
-        }
+        });
         stiffness = 1.0 / tau;
         // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
         let mut l = [0.0; 2];
@@ -816,15 +947,25 @@ fn cg_disc(
         })?;
         // The new stick set, whether a cell was released into it, and Δq of
         // the move.
-        let mut released = false;
-        for &i in cells {
-            let sticks = !on_bound(qx[i], qy[i], bound(i));
-            released |= sticks && !stick[i];
-            stick[i] = sticks;
-            dqx[i] = qx[i] - dqx[i];
-            dqy[i] = qy[i] - dqy[i];
-        }
-        conj = !released;
+        let q = (&*qx, &*qy);
+        let items: Vec<_> = chunks
+            .with2(&mut dqx, &mut dqy)
+            .into_iter()
+            .zip(chunks.split(&mut stick))
+            .collect();
+        let parts = threads.chunked(chunks, items, |((part, dqx, dqy), stick)| {
+            let mut released = false;
+            for &i in part.list() {
+                let j = i - part.start;
+                let sticks = !on_bound(q.0[i], q.1[i], bound(i));
+                released |= sticks && !stick[j];
+                stick[j] = sticks;
+                dqx[j] = q.0[i] - dqx[j];
+                dqy[j] = q.1[i] - dqy[j];
+            }
+            released
+        });
+        conj = !parts.contains(&true);
         // Slip field of the new tractions: u += C Δq.
         op.tangential_add(&dqx, &dqy, ux, uy);
         out.applications += 1;
@@ -875,16 +1016,9 @@ impl<'a> StickPrecond<'a> {
         }
     }
 
-    /// `M⁻¹ r` on stick cell `i` for the residual `r = u − m`, with `zm = α
-    /// (d − m)`: `z_i + zm`, or `r` itself without `W` (the same arithmetic
-    /// as before the preconditioner existed).
-    #[inline(always)]
-    fn stick_z(&self, i: usize, r: [f64; 2], zm: [f64; 2]) -> [f64; 2] {
-        if self.fourier.is_some() {
-            [self.z.0[i] + zm[0], self.z.1[i] + zm[1]]
-        } else {
-            r
-        }
+    /// What the passes over the stick cells read of it ([`StickZ::at`]).
+    fn view(&self) -> StickZ<'_> {
+        StickZ(self.fourier.is_some().then_some((&self.z.0, &self.z.1)))
     }
 
     /// Makes `z = Π W Π u` on the `ns` cells of `stick` of `grid`; returns α
@@ -908,6 +1042,23 @@ impl<'a> StickPrecond<'a> {
         // the symbol's units on the periodic n x n grid).
         let diameter = 2.0 * (ns as f64 * grid.cell_area() / std::f64::consts::PI).sqrt();
         *w * grid.n as f64 / (2.0 * diameter)
+    }
+}
+
+/// `Π W Π u` of a [`StickPrecond`] with `W` (x and y), `None` without.
+#[derive(Clone, Copy)]
+struct StickZ<'a>(Option<(&'a [f64], &'a [f64])>);
+
+impl StickZ<'_> {
+    /// `M⁻¹ r` on stick cell `i` for the residual `r = u − m`, with `zm = α
+    /// (d − m)`: `z_i + zm`, or `r` itself without `W` (the same arithmetic
+    /// as before the preconditioner existed).
+    #[inline(always)]
+    fn at(&self, i: usize, r: [f64; 2], zm: [f64; 2]) -> [f64; 2] {
+        match self.0 {
+            Some((zx, zy)) => [zx[i] + zm[0], zy[i] + zm[1]],
+            None => r,
+        }
     }
 }
 
