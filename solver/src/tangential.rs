@@ -494,12 +494,7 @@ fn on_grid_taking(
         }
         (mx, my, nst)
     });
-    let (mut mx, mut my, mut nst) = (0.0, 0.0, 0usize);
-    for (x, y, c) in parts {
-        mx += x;
-        my += y;
-        nst += c;
-    }
+    let (mx, my, nst) = sum_in_order(parts);
     if nst > 0 {
         shift = [mx / nst as f64, my / nst as f64];
     }
@@ -686,12 +681,7 @@ fn cg_disc(
             }
             (mx, my, ns)
         });
-        let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
-        for (x, y, c) in parts {
-            mx += x;
-            my += y;
-            ns += c;
-        }
+        let (mx, my, ns) = sum_in_order(parts);
         if ns == 0 {
             // Every cell slips: not a partial-slip state; let FISTA take over.
             return Ok(out);
@@ -1060,6 +1050,18 @@ impl StickZ<'_> {
             None => r,
         }
     }
+}
+
+/// The pieces' partial sums of (slip x, slip y, stick cells), added in the
+/// pieces' order: the same arithmetic whatever the thread count.
+fn sum_in_order(parts: impl IntoIterator<Item = (f64, f64, usize)>) -> (f64, f64, usize) {
+    let (mut mx, mut my, mut n) = (0.0, 0.0, 0usize);
+    for (x, y, c) in parts {
+        mx += x;
+        my += y;
+        n += c;
+    }
+    (mx, my, n)
 }
 
 /// Rim stiffness, relative to the cells' elastic stiffness 1/τ, above which a
