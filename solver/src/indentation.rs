@@ -19,39 +19,59 @@ pub const ANGLES: usize = 512;
 /// Samples over [0, 2π) of the Willis contact's angular integrals.
 pub const WILLIS_ANGLES: usize = 4096;
 
-/// Mean over in-plane directions of `f(θ)`, π-periodic, by the trapezoid rule.
-fn mean_over_directions(f: impl Fn(f64) -> f64) -> f64 {
-    (0..ANGLES)
-        .map(|k| f(PI * k as f64 / ANGLES as f64))
-        .sum::<f64>()
-        / ANGLES as f64
+/// The in-plane means of the surface compliance, 1/Pa, from one pass over
+/// [`ANGLES`] directions of [0, π) (trapezoid rule): `⟨H33⟩` and the
+/// tangential `⟨(H11 + H22)/2⟩` (real parts).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InPlaneMeans {
+    /// ⟨H33⟩.
+    pub normal: f64,
+    /// ⟨(H11 + H22)/2⟩.
+    pub tangential: f64,
 }
 
-/// The indentation modulus M, Pa, of Vlassak and Nix (1993, 1994): the
-/// modulus of the isotropic half-space whose point-load displacement has
-/// the same mean over in-plane directions, `M = 1/(π ⟨g33⟩)` for the real-
-/// space Green's function `u3 = g33(φ) P / r`, equivalently `M = 2/⟨H33⟩`
-/// in Fourier space (the mean is the zeroth angular harmonic, which the
-/// transform of a function homogeneous of degree −1 keeps up to the factor
-/// 2π). An isotropic half-space gives `E/(1 − ν²)`. Substrate alone: an
-/// elastic ball adds its own compliance (see [`willis_contact`]).
+impl InPlaneMeans {
+    /// The means of `m`'s surface compliance.
+    pub fn of(m: &Material) -> Self {
+        let (mut normal, mut tangential) = (0.0, 0.0);
+        for k in 0..ANGLES {
+            let h = m.surface_compliance(PI * k as f64 / ANGLES as f64);
+            normal += h[(2, 2)].re;
+            tangential += 0.5 * (h[(0, 0)].re + h[(1, 1)].re);
+        }
+        InPlaneMeans {
+            normal: normal / ANGLES as f64,
+            tangential: tangential / ANGLES as f64,
+        }
+    }
+
+    /// The indentation modulus M, Pa, of Vlassak and Nix (1993, 1994): the
+    /// modulus of the isotropic half-space whose point-load displacement
+    /// has the same mean over in-plane directions, `M = 1/(π ⟨g33⟩)` for
+    /// the real-space Green's function `u3 = g33(φ) P / r`, equivalently
+    /// `M = 2/⟨H33⟩` in Fourier space (the mean is the zeroth angular
+    /// harmonic, which the transform of a function homogeneous of degree
+    /// −1 keeps up to the factor 2π). An isotropic half-space gives
+    /// `E/(1 − ν²)`. Substrate alone: an elastic ball adds its own
+    /// compliance (see [`willis_contact`]).
+    pub fn indentation_modulus(&self) -> f64 {
+        2.0 / self.normal
+    }
+
+    /// The ratio of tangential to normal surface compliance, each averaged
+    /// over in-plane directions: `⟨(H11 + H22)/2⟩ / ⟨H33⟩`. An isotropic
+    /// half-space gives `(2 − ν)/(2(1 − ν))`, 1.214 at ν = 0.3; a larger
+    /// ratio means a softer tangential response for the same normal one (a
+    /// smaller stick zone and more energy per fretting cycle at the same
+    /// force).
+    pub fn compliance_ratio(&self) -> f64 {
+        self.tangential / self.normal
+    }
+}
+
+/// [`InPlaneMeans::indentation_modulus`] of `m`, Pa.
 pub fn indentation_modulus(m: &Material) -> f64 {
-    2.0 / mean_over_directions(|th| m.surface_compliance(th)[(2, 2)].re)
-}
-
-/// The ratio of tangential to normal surface compliance, each averaged over
-/// in-plane directions: `⟨(H11 + H22)/2⟩ / ⟨H33⟩` (real parts). An
-/// isotropic half-space gives `(2 − ν)/(2(1 − ν))`, 1.214 at ν = 0.3; a
-/// larger ratio means a softer tangential response for the same normal one
-/// (a smaller stick zone and more energy per fretting cycle at the same
-/// force).
-pub fn compliance_ratio(m: &Material) -> f64 {
-    let tangential = mean_over_directions(|th| {
-        let h = m.surface_compliance(th);
-        0.5 * (h[(0, 0)].re + h[(1, 1)].re)
-    });
-    let normal = mean_over_directions(|th| m.surface_compliance(th)[(2, 2)].re);
-    tangential / normal
+    InPlaneMeans::of(m).indentation_modulus()
 }
 
 /// Willis's frictionless contact of a sphere on an anisotropic half-space.
@@ -172,9 +192,10 @@ mod tests {
         let (e, nu) = (210e9, 0.3);
         let m = Material::isotropic("Fe", e, nu).unwrap();
         let es = e / (1.0 - nu * nu);
-        assert!((indentation_modulus(&m) / es - 1.0).abs() < 1e-12);
+        let means = InPlaneMeans::of(&m);
+        assert!((means.indentation_modulus() / es - 1.0).abs() < 1e-12);
         let ratio = (2.0 - nu) / (2.0 * (1.0 - nu));
-        assert!((compliance_ratio(&m) / ratio - 1.0).abs() < 1e-12);
+        assert!((means.compliance_ratio() / ratio - 1.0).abs() < 1e-12);
         // Hertz: a³ = 3PR/(4E*), p₀ = 3P/(2πa²), δ = a²/R.
         let (p, r) = (20.0, 18e-3);
         let h = 2.0 / es;

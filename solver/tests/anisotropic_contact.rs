@@ -40,19 +40,6 @@ fn fe111(n: usize, spacing_um: f64, ratio: f64) -> solver::CaseSpec {
     spec
 }
 
-/// Indentation modulus of Vlassak & Nix: 1/M = mean_θ H33(θ) / 2.
-fn indentation_modulus(c: &nalgebra::Matrix6<f64>) -> f64 {
-    let n = 720;
-    let mean: f64 = (0..n)
-        .map(|k| {
-            let th = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-            solver::aniso::stroh::surface_compliance(c, th)[(2, 2)].re
-        })
-        .sum::<f64>()
-        / n as f64;
-    2.0 / mean
-}
-
 /// Bilinear interpolation of a row-major field at (x, y).
 fn sample(f: &[f64], grid: &solver::operator::Grid, x: f64, y: f64) -> f64 {
     let n = grid.n;
@@ -70,7 +57,7 @@ fn sample(f: &[f64], grid: &solver::operator::Grid, x: f64, y: f64) -> f64 {
 #[test]
 fn fe111_normal_contact_follows_hertz_with_indentation_modulus_and_is_threefold() {
     let spec = fe111(384, 0.6, 0.0);
-    let m = indentation_modulus(&spec.material.stiffness());
+    let m = solver::indentation::indentation_modulus(&spec.material);
     let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
     let s = &out.scalars;
     let (p, r) = (20.0_f64, 18.0e-3_f64);

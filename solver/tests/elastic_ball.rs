@@ -213,23 +213,13 @@ fn spec_n() -> usize {
     256
 }
 
-/// Indentation modulus of Vlassak & Nix: 1/M = mean_θ H33(θ) / 2.
-fn indentation_modulus(m: &Material) -> f64 {
-    let n = 720;
-    let mean: f64 = (0..n)
-        .map(|k| m.surface_compliance(2.0 * PI * k as f64 / n as f64)[(2, 2)].re)
-        .sum::<f64>()
-        / n as f64;
-    2.0 / mean
-}
-
 #[test]
 fn crystal_substrate_under_a_steel_ball_and_the_swap() {
     // Cu(111) under a steel ball: load–approach of Hertz with
     // 1/E* = 1/M(Cu(111)) + (1 − ν²)/E(steel), to the accuracy of the
     // near-circular anisotropic contact (1.5 %, as for the rigid ball).
     let crystal = presets::material("Cu(111)").unwrap();
-    let m = indentation_modulus(&crystal);
+    let m = solver::indentation::indentation_modulus(&crystal);
     let (e, nu) = iso("steel");
     let e_star = 1.0 / (1.0 / m + (1.0 - nu * nu) / e);
     let a = (3.0 * P * R / (4.0 * e_star)).cbrt();

@@ -69,8 +69,11 @@ pub fn orientation_rows(
 ) -> Vec<OrientationRow> {
     let by_name: BTreeMap<&str, &Orientation> =
         orientations.iter().map(|o| (o.name.as_str(), o)).collect();
-    // The crystal's own quantities, once per material (and ball, load).
-    let mut crystal: BTreeMap<String, (f64, f64)> = BTreeMap::new();
+    // The crystal's own quantities, once per material; Willis's contact once
+    // per material, ball and load (not per surface).
+    let mut crystal: BTreeMap<String, solver::indentation::InPlaneMeans> = BTreeMap::new();
+    type ContactKey = (String, Option<String>, u64);
+    let mut contacts: BTreeMap<ContactKey, solver::indentation::WillisContact> = BTreeMap::new();
     let mut out: Vec<OrientationRow> = Vec::new();
     let mut index: BTreeMap<String, usize> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.case.key.level == 0) {
@@ -84,26 +87,31 @@ pub fn orientation_rows(
             continue;
         }
         let spec = &r.case.spec;
-        let (modulus, ratio) = *crystal.entry(o.name.clone()).or_insert_with(|| {
-            (
-                solver::indentation::indentation_modulus(&spec.material),
-                solver::indentation::compliance_ratio(&spec.material),
-            )
-        });
-        // The pair's normal compliance: the ball's frame is the substrate's
-        // turned 180° about x, so its direction θ is the ball's −θ.
-        let ball = spec.indenter.clone();
-        let h33 = |th: f64| {
-            spec.material.surface_compliance(th)[(2, 2)].re
-                + ball
-                    .as_ref()
-                    .map_or(0.0, |b| b.surface_compliance(-th)[(2, 2)].re)
-        };
-        let contact = solver::indentation::willis_contact(
-            &h33,
-            spec.load.normal_force_n,
-            spec.load.indenter_radius_m,
-        );
+        let means = *crystal
+            .entry(o.name.clone())
+            .or_insert_with(|| solver::indentation::InPlaneMeans::of(&spec.material));
+        let ball = spec.indenter.as_ref();
+        let contact = *contacts
+            .entry((
+                o.name.clone(),
+                ball.map(|b| b.name.clone()),
+                spec.load.normal_force_n.to_bits(),
+            ))
+            .or_insert_with(|| {
+                // The pair's normal compliance: the ball's frame is the
+                // substrate's turned 180° about x, so its direction θ is the
+                // ball's −θ.
+                let h33 = |th: f64| {
+                    spec.material.surface_compliance(th)[(2, 2)].re
+                        + ball.map_or(0.0, |b| b.surface_compliance(-th)[(2, 2)].re)
+                };
+                solver::indentation::willis_contact(
+                    &h33,
+                    spec.load.normal_force_n,
+                    spec.load.indenter_radius_m,
+                )
+            });
+        let (modulus, ratio) = (means.indentation_modulus(), means.compliance_ratio());
         index.insert(text, out.len());
         out.push(OrientationRow {
             orientation: (*o).clone(),
