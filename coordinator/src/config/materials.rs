@@ -78,8 +78,8 @@ impl Config {
     /// (`Cu[1 2 3]`), `[materials.NAME]`, then presets.
     pub fn material(&self, name: &str) -> Result<Material> {
         if self.sweep.orientations.is_some() && !self.materials.contains_key(name) {
-            if let Some(m) = self.sweep_materials()?.into_iter().find(|m| m.name == name) {
-                return Ok(m.material);
+            if let Some(o) = self.orientations()?.into_iter().find(|o| o.name == name) {
+                return self.cut(&o);
             }
         }
         self.material_for("sweep.materials", name)
@@ -89,7 +89,7 @@ impl Config {
     /// `sweep.orientations` each crystal once per orientation. Errors name
     /// the key.
     pub fn sweep_materials(&self) -> Result<Vec<SweepMaterial>> {
-        let Some(orientations) = &self.sweep.orientations else {
+        if self.sweep.orientations.is_none() {
             return self
                 .sweep
                 .materials
@@ -102,6 +102,48 @@ impl Config {
                     })
                 })
                 .collect();
+        }
+        self.orientations()?
+            .into_iter()
+            .map(|o| {
+                Ok(SweepMaterial {
+                    name: o.name.clone(),
+                    material: self.cut(&o)?,
+                    orientation: Some(o),
+                })
+            })
+            .collect()
+    }
+
+    /// The crystal `o.base` cut at the orientation `o`.
+    fn cut(&self, o: &Orientation) -> Result<Material> {
+        let cfg = &self.materials[&o.base];
+        let explain = |e| {
+            anyhow!(
+                "sweep.orientations: {} of `{}`: {e}",
+                super::orientations::miller_text(o.normal),
+                o.base
+            )
+        };
+        cubic(&o.name, cfg, o.normal, o.x_dir, &explain)
+    }
+
+    /// The name of the sweep's first material (a single case's default):
+    /// the first of `sweep.materials`, at its first orientation with
+    /// `sweep.orientations`.
+    pub fn first_material(&self) -> Result<String> {
+        if self.sweep.orientations.is_none() {
+            return Ok(self.sweep.materials[0].clone());
+        }
+        Ok(self.orientations()?.swap_remove(0).name)
+    }
+
+    /// The orientations of `sweep.orientations` in order, crystal by
+    /// crystal (empty without the key): every material of the sweep must
+    /// be a cubic `[materials.NAME]` table without `normal`/`x_dir`.
+    pub fn orientations(&self) -> Result<Vec<Orientation>> {
+        let Some(orientations) = &self.sweep.orientations else {
+            return Ok(Vec::new());
         };
         let mut out = Vec::new();
         for base in &self.sweep.materials {
@@ -115,44 +157,9 @@ impl Config {
             if cfg.normal.is_some() || cfg.x_dir.is_some() {
                 bail!("materials.{base}.normal: sweep.orientations gives the orientations of `{base}`; leave `normal` and `x_dir` out of its table");
             }
-            for o in super::orientations::expand(base, orientations)? {
-                let explain = |e| {
-                    anyhow!(
-                        "sweep.orientations: {} of `{base}`: {e}",
-                        super::orientations::miller_text(o.normal)
-                    )
-                };
-                let material = cubic(&o.name, cfg, o.normal, o.x_dir, &explain)?;
-                out.push(SweepMaterial {
-                    name: o.name.clone(),
-                    material,
-                    orientation: Some(o),
-                });
-            }
+            out.extend(super::orientations::expand(base, orientations)?);
         }
         Ok(out)
-    }
-
-    /// The name of the sweep's first material (a single case's default):
-    /// the first of `sweep.materials`, at its first orientation with
-    /// `sweep.orientations`.
-    pub fn first_material(&self) -> Result<String> {
-        if self.sweep.orientations.is_none() {
-            return Ok(self.sweep.materials[0].clone());
-        }
-        Ok(self.sweep_materials()?.swap_remove(0).name)
-    }
-
-    /// The orientations of `sweep.orientations` (empty without the key).
-    pub fn orientations(&self) -> Result<Vec<Orientation>> {
-        if self.sweep.orientations.is_none() {
-            return Ok(Vec::new());
-        }
-        Ok(self
-            .sweep_materials()?
-            .into_iter()
-            .filter_map(|m| m.orientation)
-            .collect())
     }
 
     /// The ball's material (`indenter.material`), `None` for a rigid ball.
