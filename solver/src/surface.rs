@@ -274,10 +274,9 @@ impl Surface {
                 }
             }
             Surface::Lattice { height, .. } | Surface::Stripes { height, .. } => {
-                let raised = self.raised_fraction(grid);
-                for (h, &f) in h.iter_mut().zip(&raised) {
-                    let upper = if *height > 0.0 { f } else { 1.0 - f };
-                    *h = if upper >= MIN_COVER {
+                let upper = self.upper_fraction(grid, *height);
+                for (h, &f) in h.iter_mut().zip(&upper) {
+                    *h = if f >= MIN_COVER {
                         height.max(0.0)
                     } else {
                         height.min(0.0)
@@ -314,19 +313,30 @@ impl Surface {
         };
         let mut cut = false;
         let cover: Vec<f64> = self
-            .raised_fraction(grid)
+            .upper_fraction(grid, height)
             .into_iter()
             .map(|f| {
-                let upper = if height > 0.0 { f } else { 1.0 - f };
-                if (MIN_COVER..1.0).contains(&upper) {
+                if (MIN_COVER..1.0).contains(&f) {
                     cut = true;
-                    upper
+                    f
                 } else {
                     1.0
                 }
             })
             .collect();
         cut.then_some(cover)
+    }
+
+    /// The fraction of each cell's area on the pattern's upper level: the
+    /// raised part for islands and ridges (`height > 0`), the rest for
+    /// dimples and grooves. What [`Surface::heights`] and
+    /// [`Surface::cover`] of an area-sampled pattern both read.
+    fn upper_fraction(&self, grid: &Grid, height: f64) -> Vec<f64> {
+        let mut f = self.raised_fraction(grid);
+        if height <= 0.0 {
+            f.iter_mut().for_each(|v| *v = 1.0 - *v);
+        }
+        f
     }
 
     /// The sampling of a patterned surface (`None` for flat surfaces and
