@@ -204,7 +204,7 @@ impl Solved {
             angle_deg: c.angle_deg,
             status: Status::of_solved(self.scalars.converged),
             scalars: &self.scalars,
-            apparent_radius_definition: solver::APPARENT_RADIUS_DEFINITION,
+            apparent_radius_definition: c.spec.numerics.radii.definition(),
             apparent_radius_definition_cells: solver::APPARENT_RADIUS_DEFINITION_CELLS,
             grid_points: c.spec.grid.n,
             spacing_m: c.spec.grid.dx,

@@ -64,7 +64,9 @@ pub use wire::{
 /// 4: a patterned surface in the payload carries its sampling (issue #34).
 /// 5: an assignment may ask for the stresses below the surface (`[stress]`,
 /// issue #38) and a result carries their scalars.
-pub const PROTOCOL_VERSION: u32 = 5;
+/// 6: a case's numerics carry the definition of the apparent radii
+/// (`solver.radii`, issue #34).
+pub const PROTOCOL_VERSION: u32 = 6;
 
 #[cfg(test)]
 mod tests;

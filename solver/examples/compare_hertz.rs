@@ -263,6 +263,7 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
             max_iterations: 20_000,
             coupling_tolerance: 1e-8,
             max_coupling_iterations: 50,
+            ..Numerics::default()
         },
         history: None,
         indenter: None,

@@ -9,10 +9,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::error::SolverError;
-use crate::geometry::{covered_area, equivalent_radius, subcell_hull_area};
+use crate::geometry::{covered_area, equivalent_radius, moment_radius, subcell_hull_area};
 use crate::kernels::Resident;
 use crate::normal::{NormalProblem, NormalSolution};
 use crate::operator::{X, Y, Z};
+use crate::spec::Radii;
 use crate::spec::{CaseSpec, LoadHistory};
 
 /// How the dissipated energy is computed.
@@ -37,7 +38,7 @@ pub struct HistoryStep {
     pub contact_area_m2: f64,
     /// Stick area (contact cells with |q| < μp), m².
     pub stick_area_m2: f64,
-    /// Apparent stick radius (sub-cell boundary, as the case's `stick_radius_m`), m.
+    /// Apparent stick radius (the case's `stick_radius_m` definition, `solver.radii`), m.
     pub stick_radius_m: f64,
     /// Energy dissipated in this increment ([`DISSIPATION_DEFINITION`]), J.
     pub dissipated_j: f64,
@@ -408,10 +409,15 @@ fn row(
     let reserve: Vec<f64> = (0..len)
         .map(|i| (mu * p[i] - tan.qx[i].hypot(tan.qy[i])).max(0.0))
         .collect();
-    let stick_radius = if stick.iter().any(|&b| b) {
-        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights, cover))
-    } else {
+    let stick_radius = if !stick.iter().any(|&b| b) {
         0.0
+    } else if spec.numerics.radii == Radii::Moments {
+        let on_stick: Vec<f64> = (0..len)
+            .map(|i| if stick[i] { reserve[i] } else { 0.0 })
+            .collect();
+        moment_radius(&grid, &on_stick)
+    } else {
+        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights, cover))
     };
     HistoryStep {
         step: sums.step,

@@ -111,8 +111,8 @@ pub use parallel::Threads;
 pub use progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
 pub use results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
-    APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS, K_E_DEFINITION,
-    K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+    APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
+    APPARENT_RADIUS_DEFINITION_MOMENTS, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
-pub use spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
+pub use spec::{CaseSpec, Load, LoadHistory, Numerics, Radii, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
 pub use surface::{Island, LatticeKind, Sampling, Surface, MIN_COVER};

@@ -7,10 +7,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::ContactState;
 use crate::error::SolverError;
-use crate::geometry::{covered_area, equivalent_radius, hull_area, subcell_hull_area};
+use crate::geometry::{
+    covered_area, equivalent_radius, hull_area, moment_radius, subcell_hull_area,
+};
 use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
+use crate::spec::Radii;
 use crate::spec::{CaseSpec, Load, MIN_RESOLVED_CELLS};
 use crate::tangential::{TangentialReport, TangentialSolution};
 
@@ -150,6 +153,10 @@ pub struct CaseOutput {
 /// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
 /// used for `mu_a` and `k_e`) are defined.
 pub const APPARENT_RADIUS_DEFINITION: &str = "radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres: along every row and column, the zero of p^2 ((mu p - |q|)^2 for stick) extrapolated linearly outward from the two outermost cells, kept within one cell pitch (the cell face where the level does not fall outward)";
+
+/// The second-moment definition of the apparent radii (`solver.radii =
+/// "moments"`; the default is [`APPARENT_RADIUS_DEFINITION`]).
+pub const APPARENT_RADIUS_DEFINITION_MOMENTS: &str = "radius from the second moment about the centroid, r^2 = 5/2 <r^2>, of the pressure over the contact cells (of mu p - |q| over the stick cells): exact for a Hertz pressure and a Cattaneo-Mindlin stick zone, continuous in the solution";
 
 /// How the paper's radii (`contact_radius_cells_m`, `stick_radius_cells_m`,
 /// used for `mu_a_cells` and `k_e_cells`) are defined.
@@ -345,6 +352,28 @@ pub(crate) fn reduce(
         ))
     } else {
         a_sub
+    };
+    // The radii of μa: the sub-cell hull's (default) or the second moments'.
+    let (a_sub, c_sub) = match spec.numerics.radii {
+        Radii::Hull => (a_sub, c_sub),
+        Radii::Moments => {
+            let a_m = moment_radius(&grid, &p);
+            let c_m = if has_stick_set {
+                let reserve: Vec<f64> = (0..len)
+                    .map(|i| {
+                        if stick_in_contact[i] {
+                            (friction * p[i] - qx[i].hypot(qy[i])).max(0.0)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                moment_radius(&grid, &reserve)
+            } else {
+                a_m
+            };
+            (a_m, c_m)
+        }
     };
     let mut s = CaseScalars {
         contact_radius_m: a_sub,

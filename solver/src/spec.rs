@@ -61,6 +61,39 @@ pub struct Numerics {
     pub coupling_tolerance: f64,
     /// Budget of coupling (normal ↔ tangential) iterations.
     pub max_coupling_iterations: usize,
+    /// How the apparent radii a and c of μa (Eq. 19) are read from the
+    /// solution.
+    #[serde(default)]
+    pub radii: Radii,
+}
+
+/// The definition of the apparent contact and stick radii that μa and K_E
+/// use (PHYSICS.md §7 leaves it to the product, the convex hull being the
+/// default; docs/physics-choices.md, "Apparent radii").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Radii {
+    /// The circle with the area of the convex hull of the contact (stick)
+    /// boundary, located between cell centres
+    /// ([`crate::APPARENT_RADIUS_DEFINITION`]).
+    #[default]
+    Hull,
+    /// From the second moment of the pressure (of μp − |q| on the stick
+    /// cells) about its centroid, `r² = 5/2 ⟨r²⟩`
+    /// ([`crate::APPARENT_RADIUS_DEFINITION_MOMENTS`]): exact for Hertz and
+    /// Cattaneo–Mindlin, and continuous in the solution, so that patterned
+    /// μa converges monotonically with the grid.
+    Moments,
+}
+
+impl Radii {
+    /// The definition's text, as outputs state it.
+    pub fn definition(self) -> &'static str {
+        match self {
+            Radii::Hull => crate::results::APPARENT_RADIUS_DEFINITION,
+            Radii::Moments => crate::results::APPARENT_RADIUS_DEFINITION_MOMENTS,
+        }
+    }
 }
 
 impl Default for Numerics {
@@ -75,6 +108,7 @@ impl Default for Numerics {
             max_iterations: 5000,
             coupling_tolerance: 1e-7,
             max_coupling_iterations: 50,
+            radii: Radii::Hull,
         }
     }
 }

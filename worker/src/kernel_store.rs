@@ -407,6 +407,7 @@ mod tests {
                 max_iterations: 2000,
                 coupling_tolerance: 1e-8,
                 max_coupling_iterations: 5,
+                ..Numerics::default()
             },
             history: None,
             indenter: None,

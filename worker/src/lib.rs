@@ -486,6 +486,7 @@ mod tests {
                 max_iterations: 2000,
                 coupling_tolerance: 1e-6,
                 max_coupling_iterations: 5,
+                ..Numerics::default()
             },
             history: None,
             indenter: None,

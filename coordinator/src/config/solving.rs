@@ -28,6 +28,9 @@ pub struct SolverCfg {
     /// Coupling loop budget.
     #[serde(default = "default_citer")]
     pub max_coupling_iterations: usize,
+    /// Definition of the apparent radii of μa.
+    #[serde(default)]
+    pub radii: solver::Radii,
 }
 
 fn yes() -> bool {
@@ -59,6 +62,7 @@ impl Default for SolverCfg {
             max_iterations: default_iter(),
             coupling_tolerance: default_ctol(),
             max_coupling_iterations: default_citer(),
+            radii: solver::Radii::default(),
         }
     }
 }
@@ -114,6 +118,7 @@ impl SolverCfg {
             max_iterations: self.max_iterations,
             coupling_tolerance: self.coupling_tolerance,
             max_coupling_iterations: self.max_coupling_iterations,
+            radii: self.radii,
         }
     }
 }

@@ -250,7 +250,12 @@ fn write_outputs(
     let levels = cases.iter().map(|c| c.key.level + 1).max().unwrap_or(1);
     let (points, incomplete) = output::curve_points(&rows, levels);
     write("curves.csv", output::curves_csv(&points))?;
-    summary.apparent_radius_definition = solver::APPARENT_RADIUS_DEFINITION;
+    // One definition per run (`solver.radii` is a key of the whole config).
+    summary.apparent_radius_definition = cases
+        .first()
+        .map_or(solver::APPARENT_RADIUS_DEFINITION, |c| {
+            c.spec.numerics.radii.definition()
+        });
     summary.apparent_radius_definition_cells = solver::APPARENT_RADIUS_DEFINITION_CELLS;
     summary.k_e_definition = solver::K_E_DEFINITION;
     summary.error_estimate = crate::convergence::ERROR_ESTIMATE;

@@ -200,6 +200,7 @@ pub(crate) mod tests {
             max_iterations: 100,
             coupling_tolerance: 1e-6,
             max_coupling_iterations: 5,
+            ..Numerics::default()
         }
     }
 
