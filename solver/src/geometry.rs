@@ -23,23 +23,25 @@ pub fn hull_area(grid: &Grid, mask: &[bool]) -> f64 {
     polygon_area(&convex_hull(pts))
 }
 
-/// Radius (m) of a zone from the second moment of a weight over it:
-/// `sqrt(5/2 · Σ w r² / Σ w)`, `r` measured from the weight's own centroid
-/// (`weight`: one value per cell, ≥ 0, zero off the zone). A Hertz-shaped
+/// Radius (m) of the zone `mask` from the second moment of the weight
+/// `level` over it: `sqrt(5/2 · Σ w r² / Σ w)`, `r` measured from the
+/// weight's own centroid (cells outside the mask, or of level ≤ 0, weigh
+/// nothing). A Hertz-shaped
 /// weight `√(1 − r²/a²)` on a disc of radius `a` has `⟨r²⟩ = 2a²/5`, so the
 /// radius is exactly `a` in the continuum (the pressure of a Hertz contact;
 /// μp − |q| on a Cattaneo–Mindlin stick zone, a Hertz shape on `c`). Unlike
 /// a hull, it is continuous in the weight: a cell or a far island that joins
 /// the zone with a small weight moves it by that weight's share. Zero for a
 /// zero weight.
-pub fn moment_radius(grid: &Grid, weight: &[f64]) -> f64 {
+pub fn moment_radius(grid: &Grid, mask: &[bool], level: &[f64]) -> f64 {
     let n = grid.n;
+    let weight = |i: usize| if mask[i] { level[i] } else { 0.0 };
     // Sums row by row in a fixed order (results do not depend on threads).
     let (mut w, mut wx, mut wy) = (0.0, 0.0, 0.0);
     for iy in 0..n {
         let y = grid.y(iy);
         for ix in 0..n {
-            let v = weight[iy * n + ix];
+            let v = weight(iy * n + ix);
             if v > 0.0 {
                 w += v;
                 wx += v * grid.x(ix);
@@ -55,7 +57,7 @@ pub fn moment_radius(grid: &Grid, weight: &[f64]) -> f64 {
     for iy in 0..n {
         let dy = grid.y(iy) - cy;
         for ix in 0..n {
-            let v = weight[iy * n + ix];
+            let v = weight(iy * n + ix);
             if v > 0.0 {
                 let dx = grid.x(ix) - cx;
                 wr2 += v * (dx * dx + dy * dy);
@@ -219,7 +221,8 @@ mod tests {
                     (1.0 - (r / r0).powi(2)).max(0.0).sqrt()
                 })
                 .collect();
-            let err = (moment_radius(&grid, &w) / r0 - 1.0).abs();
+            let mask: Vec<bool> = w.iter().map(|&v| v > 0.0).collect();
+            let err = (moment_radius(&grid, &mask, &w) / r0 - 1.0).abs();
             assert!(err < 0.05 * (h / r0).powf(1.5), "{n}: {err}");
             errs.push(err);
         }
@@ -251,7 +254,7 @@ mod tests {
             w[far] = eps * total;
             let mask: Vec<bool> = w.iter().map(|&v| v > 0.0).collect();
             (
-                moment_radius(&grid, &w),
+                moment_radius(&grid, &mask, &w),
                 equivalent_radius(hull_area(&grid, &mask)),
             )
         };

@@ -9,11 +9,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::error::SolverError;
-use crate::geometry::{covered_area, equivalent_radius, moment_radius, subcell_hull_area};
+use crate::geometry::covered_area;
 use crate::kernels::Resident;
 use crate::normal::{NormalProblem, NormalSolution};
 use crate::operator::{X, Y, Z};
-use crate::spec::Radii;
+use crate::results::{apparent_radius, friction_reserve};
 use crate::spec::{CaseSpec, LoadHistory};
 
 /// How the dissipated energy is computed.
@@ -406,18 +406,17 @@ fn row(
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
     let stick: Vec<bool> = (0..len).map(|i| contact[i] && tan.stick[i]).collect();
     let count = |v: &[bool]| covered_area(v, cover, da);
-    let reserve: Vec<f64> = (0..len)
-        .map(|i| (mu * p[i] - tan.qx[i].hypot(tan.qy[i])).max(0.0))
-        .collect();
-    let stick_radius = if !stick.iter().any(|&b| b) {
-        0.0
-    } else if spec.numerics.radii == Radii::Moments {
-        let on_stick: Vec<f64> = (0..len)
-            .map(|i| if stick[i] { reserve[i] } else { 0.0 })
-            .collect();
-        moment_radius(&grid, &on_stick)
+    let stick_radius = if stick.iter().any(|&b| b) {
+        let reserve = friction_reserve(mu, p, (&tan.qx, &tan.qy));
+        apparent_radius(
+            spec.numerics.radii,
+            &grid,
+            &stick,
+            &reserve,
+            (heights, cover),
+        )
     } else {
-        equivalent_radius(subcell_hull_area(&grid, &stick, &reserve, heights, cover))
+        0.0
     };
     HistoryStep {
         step: sums.step,

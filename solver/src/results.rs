@@ -163,6 +163,33 @@ pub const APPARENT_RADIUS_DEFINITION_MOMENTS: &str = "radius from the second mom
 pub const APPARENT_RADIUS_DEFINITION_CELLS: &str =
     "radius of the circle with the area of the convex hull of the contact (stick) cells, each cell taken as its full square (the paper's definition)";
 
+/// The apparent radius (m) of the zone `mask` of `grid` under the
+/// definition `radii`, from its level field (the pressure on the contact,
+/// [`friction_reserve`] on the stick zone): the sub-cell hull's
+/// ([`APPARENT_RADIUS_DEFINITION`]; `terrain`: heights and cover, which
+/// bound it at island edges) or the second moment's
+/// ([`APPARENT_RADIUS_DEFINITION_MOMENTS`]).
+pub(crate) fn apparent_radius(
+    radii: Radii,
+    grid: &crate::grid::Grid,
+    mask: &[bool],
+    level: &[f64],
+    (heights, cover): (&[f64], Option<&[f64]>),
+) -> f64 {
+    match radii {
+        Radii::Hull => equivalent_radius(subcell_hull_area(grid, mask, level, heights, cover)),
+        Radii::Moments => moment_radius(grid, mask, level),
+    }
+}
+
+/// The stick zone's friction reserve `(μp − |q|)⁺` per cell, Pa: the level
+/// whose zero is a Mindlin stick edge.
+pub(crate) fn friction_reserve(mu: f64, p: &[f64], (qx, qy): (&[f64], &[f64])) -> Vec<f64> {
+    (0..p.len())
+        .map(|i| (mu * p[i] - qx[i].hypot(qy[i])).max(0.0))
+        .collect()
+}
+
 /// How K_E in μa is obtained.
 pub const K_E_DEFINITION: &str = "isotropic: K_E = 8E/(3(1+nu)(2-nu)) (paper Eq. 19); anisotropic: K_E(psi) = mu P (a^2 - c^2)/(delta_F a^3) calibrated on the flat surface of the same material at the same force angle";
 
@@ -335,45 +362,19 @@ pub(crate) fn reduce(
         && (0..len).any(|i| contact[i] && heights[i] < top);
     let hertz_radius =
         (3.0 * load * spec.load.indenter_radius_m / (4.0 * spec.contact_modulus())).cbrt();
-    // Sub-cell radii: p falls to zero like the root of the distance at a
-    // Hertzian edge, and μp − |q| does at a Mindlin stick edge.
+    // The radii of μa (`solver.radii`): by default the sub-cell hulls (p
+    // falls to zero like the root of the distance at a Hertzian edge, and
+    // μp − |q| does at a Mindlin stick edge), or the second moments of the
+    // same two levels.
     let friction = spec.load.friction;
-    let a_sub = equivalent_radius(subcell_hull_area(&grid, &contact, &p, &heights, cover));
+    let radii = spec.numerics.radii;
+    let terrain = (&heights[..], cover);
+    let a_sub = apparent_radius(radii, &grid, &contact, &p, terrain);
     let c_sub = if has_stick_set {
-        let reserve: Vec<f64> = (0..len)
-            .map(|i| (friction * p[i] - qx[i].hypot(qy[i])).max(0.0))
-            .collect();
-        equivalent_radius(subcell_hull_area(
-            &grid,
-            &stick_in_contact,
-            &reserve,
-            &heights,
-            cover,
-        ))
+        let reserve = friction_reserve(friction, &p, (&qx, &qy));
+        apparent_radius(radii, &grid, &stick_in_contact, &reserve, terrain)
     } else {
         a_sub
-    };
-    // The radii of μa: the sub-cell hull's (default) or the second moments'.
-    let (a_sub, c_sub) = match spec.numerics.radii {
-        Radii::Hull => (a_sub, c_sub),
-        Radii::Moments => {
-            let a_m = moment_radius(&grid, &p);
-            let c_m = if has_stick_set {
-                let reserve: Vec<f64> = (0..len)
-                    .map(|i| {
-                        if stick_in_contact[i] {
-                            (friction * p[i] - qx[i].hypot(qy[i])).max(0.0)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
-                moment_radius(&grid, &reserve)
-            } else {
-                a_m
-            };
-            (a_m, c_m)
-        }
     };
     let mut s = CaseScalars {
         contact_radius_m: a_sub,
