@@ -289,7 +289,7 @@ fn solve_nested_taking(
     handed: Handed,
 ) -> Result<TangentialSolution, SolverError> {
     if handed.is_some() || !matches!(prob.start, TangentialStart::Proportional) {
-        let fourier = prob.precondition.then(|| {
+        let fourier = fourier_pays(prob, op.grid()).then(|| {
             let grid = op.grid();
             levels
                 .fourier
@@ -403,7 +403,7 @@ fn on_grid_taking(
     let mut own = None;
     let fourier = match fourier {
         Some(f) => Some(f),
-        None if prob.precondition => Some(own.insert(FourierPrecond::new(grid))),
+        None if fourier_pays(prob, grid) => Some(own.insert(FourierPrecond::new(grid))),
         None => None,
     };
     let cg = cg_disc(
@@ -982,6 +982,24 @@ struct StickPrecond<'a> {
     fourier: Option<(&'a mut FourierPrecond, f64)>,
     /// `Π W Π u` on the stick cells, x and y (empty without `W`).
     z: (Vec<f64>, Vec<f64>),
+}
+
+/// Largest side of the grid (or contact window) on which a solve that asks
+/// for the Fourier stick preconditioner ([`TangentialProblem::precondition`])
+/// gets it; above, it keeps Jacobi. Table 1(a) uncoupled, first loading in 5
+/// increments of 0.12 μP, tangential iterations per increment (Fourier /
+/// Jacobi): 1024² 37, 50, 70, 79, 102 / 111, 113, 105, 111, 76 (Fourier
+/// 338 in all against 516); 2048² 56, 186, 253, 343, 1694 / 125, 177, 109,
+/// 125, 117 (2532 against 653: the Fourier-preconditioned iteration degrades
+/// as the stick zone shrinks, cause not found). Both grids have the same
+/// geometry in cells (no window), so it is the resolution that differs.
+/// At 256² and 512² (fretting, 60 increments) Fourier halves the iterations
+/// (docs/performance.md, round 3).
+pub const FOURIER_STICK_MAX_SIDE: usize = 1024;
+
+/// Whether `prob`'s solve on `grid` uses the Fourier stick preconditioner.
+fn fourier_pays(prob: &TangentialProblem, grid: crate::grid::Grid) -> bool {
+    prob.precondition && grid.n <= FOURIER_STICK_MAX_SIDE
 }
 
 /// Diagonal of the stick cells' Fourier preconditioner relative to the

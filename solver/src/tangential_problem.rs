@@ -100,6 +100,8 @@ pub struct TangentialProblem<'a> {
     pub start: TangentialStart<'a>,
     /// Precondition the conjugate gradient's stick cells with the Fourier
     /// inverse of the compliance (a load history's increments, which start
-    /// next to their solution); false: the diagonal (Jacobi) preconditioner.
+    /// next to their solution), on grids or windows of side up to
+    /// [`crate::tangential::FOURIER_STICK_MAX_SIDE`]; false (or a larger
+    /// side): the diagonal (Jacobi) preconditioner.
     pub precondition: bool,
 }
