@@ -12,16 +12,8 @@
 #        THREADS=1 bench/fretting.sh [SIZES]   (solve's --threads; default all cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# MPCONTACT_EXE: another build's binary (e.g. main's, for alternating runs).
-exe=${MPCONTACT_EXE:-}
-if [ -z "$exe" ]; then
-  cargo build --release -q --bin mpcontact
-  exe=target/release/mpcontact
-fi
+. bench/solve-common.sh
 sizes=${1:-"256:1 512:0.5"}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-field() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
 echo "| grid | coupling | monotonic solve s | its (t) | history: 60 increments s | its (t) | per increment s | one cycle (40) s | cycle / monotonic | converged | energy per cycle J |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for s in $sizes; do

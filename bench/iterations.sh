@@ -12,16 +12,9 @@
 #        STEPS=5 THREADS=2 MPCONTACT_EXE=/path/to/mpcontact bench/iterations.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-exe=${MPCONTACT_EXE:-}
-if [ -z "$exe" ]; then
-  cargo build --release -q --bin mpcontact
-  exe=target/release/mpcontact
-fi
+. bench/solve-common.sh
 sizes=${1:-"512:0.5 1024:0.25 2048:0.125"}
 steps=${STEPS:-5}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-get() { python3 -c "import json,sys; c=json.load(open(sys.argv[1])); print(c[sys.argv[2]])" "$1" "$2"; }
 echo "| grid | coupling | monotonic s | its (t) per monotonic solve | coupling passes | history s ($steps increments) | its (t) per increment | passes per increment | converged |"
 echo "|---|---|---|---|---|---|---|---|---|"
 for s in $sizes; do
@@ -31,10 +24,10 @@ for s in $sizes; do
     $exe solve configs/paper-1a-fe.toml "${args[@]}" --out "$tmp/m" > /dev/null
     $exe solve configs/paper-1a-fe.toml "${args[@]}" --set 'history.tangential_ratios=[0.0, 0.6]' \
       --set history.steps_per_segment=$steps --out "$tmp/h" > /dev/null
-    ms=$(get "$tmp/m/case.json" seconds); mi=$(get "$tmp/m/case.json" tangential_iterations)
-    mc=$(get "$tmp/m/case.json" coupling_iterations)
-    hs=$(get "$tmp/h/case.json" seconds); hi=$(get "$tmp/h/case.json" tangential_iterations)
-    hc=$(get "$tmp/h/case.json" coupling_iterations); ok=$(get "$tmp/h/case.json" converged)
+    ms=$(field "$tmp/m/case.json" seconds); mi=$(field "$tmp/m/case.json" tangential_iterations)
+    mc=$(field "$tmp/m/case.json" coupling_iterations)
+    hs=$(field "$tmp/h/case.json" seconds); hi=$(field "$tmp/h/case.json" tangential_iterations)
+    hc=$(field "$tmp/h/case.json" coupling_iterations); ok=$(field "$tmp/h/case.json" converged)
     python3 -c "print(f'| {$n}² | $coupling | {$ms:.1f} | $mi | $mc | {$hs:.1f} | {$hi/$steps:.1f} | {$hc/$steps:.1f} | $ok |')"
   done
 done
