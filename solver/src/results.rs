@@ -13,8 +13,7 @@ use crate::geometry::{
 use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
-use crate::spec::Radii;
-use crate::spec::{CaseSpec, Load, MIN_RESOLVED_CELLS};
+use crate::spec::{CaseSpec, Load, Radii, MIN_RESOLVED_CELLS};
 use crate::tangential::{TangentialReport, TangentialSolution};
 
 /// The scalars of one solved case.
@@ -369,16 +368,16 @@ pub(crate) fn reduce(
     let friction = spec.load.friction;
     let radii = spec.numerics.radii;
     let terrain = (&heights[..], cover);
-    let a_sub = apparent_radius(radii, &grid, &contact, &p, terrain);
-    let c_sub = if has_stick_set {
+    let a_app = apparent_radius(radii, &grid, &contact, &p, terrain);
+    let c_app = if has_stick_set {
         let reserve = friction_reserve(friction, &p, (&qx, &qy));
         apparent_radius(radii, &grid, &stick_in_contact, &reserve, terrain)
     } else {
-        a_sub
+        a_app
     };
     let mut s = CaseScalars {
-        contact_radius_m: a_sub,
-        stick_radius_m: c_sub,
+        contact_radius_m: a_app,
+        stick_radius_m: c_app,
         contact_radius_cells_m: a,
         stick_radius_cells_m: c,
         delta_t_m: shift[0] * dir[0] + shift[1] * dir[1],
@@ -409,7 +408,7 @@ pub(crate) fn reduce(
         kernel_seconds,
         history,
     };
-    let annulus = c < a && c_sub < a_sub && c >= min_radius;
+    let annulus = c < a && c_app < a_app && c >= min_radius;
     if fnorm > 0.0 && (is_history || !converged) {
         if annulus {
             s.mu_a = Some(mu_apparent(&s, load, s.k_e));
@@ -433,10 +432,10 @@ pub(crate) fn reduce(
                 },
             });
         }
-        if c_sub >= a_sub {
+        if c_app >= a_app {
             return Err(SolverError::SlipUnresolved {
                 detail: format!(
-                    "the stick zone's boundary reaches the contact boundary, c = a = {a_sub:.4e} m"
+                    "the stick zone's boundary reaches the contact boundary, c = a = {a_app:.4e} m"
                 ),
             });
         }

@@ -69,7 +69,8 @@ pub struct Numerics {
 
 /// The definition of the apparent contact and stick radii that μa and K_E
 /// use (PHYSICS.md §7 leaves it to the product, the convex hull being the
-/// default; docs/physics-choices.md, "Apparent radii").
+/// default; docs/physics-choices.md, "Reported quantities": apparent radii
+/// from second moments).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Radii {

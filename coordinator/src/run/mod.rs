@@ -253,9 +253,9 @@ fn write_outputs(
     // One definition per run (`solver.radii` is a key of the whole config).
     summary.apparent_radius_definition = cases
         .first()
-        .map_or(solver::APPARENT_RADIUS_DEFINITION, |c| {
-            c.spec.numerics.radii.definition()
-        });
+        .map(|c| c.spec.numerics.radii)
+        .unwrap_or_default()
+        .definition();
     summary.apparent_radius_definition_cells = solver::APPARENT_RADIUS_DEFINITION_CELLS;
     summary.k_e_definition = solver::K_E_DEFINITION;
     summary.error_estimate = crate::convergence::ERROR_ESTIMATE;
