@@ -7,11 +7,13 @@
 //! {ΔA Σq = F}, solved by a projected conjugate gradient over the stick
 //! cells' tractions and the slip cells' rotation on their discs (`cg_disc`),
 //! and by accelerated projected gradient (FISTA with adaptive restart) from
-//! where it stopped if its KKT residual stalls. Both end on the exact
-//! Euclidean projection onto that set, which shifts all tractions by one 2-D
-//! multiplier λ (found by Newton's method) before clipping them to their
-//! discs; the rigid shift δt of the sphere is the stick cells' mean slip (CG)
-//! or λ divided by the step (FISTA). A warm start that asks for it (a load
+//! where it stopped if its KKT residual stalls. Both end on a projection
+//! onto that set, which shifts the tractions by one 2-D multiplier λ (found
+//! by Newton's method) before clipping them to their discs: FISTA's is the
+//! exact Euclidean projection (all tractions shifted); the CG's shifts all
+//! but the slip cells it moved along their rims, which it holds there. The
+//! rigid shift δt of the sphere is the stick cells' mean slip (CG) or λ
+//! divided by the step (FISTA). A warm start that asks for it (a load
 //! history's uncoupled increments) preconditions the CG's stick cells with the
 //! Fourier inverse of the compliance (`StickPrecond`), which halves their
 //! iterations; the answer is the same problem's to the same KKT tolerance.
@@ -109,11 +111,18 @@ impl<'a> Feasible<'a> {
 
 /// Exact projection of `z` onto the feasible set: q_i = Π_i(z_i + λ).
 /// Returns `None` if no λ satisfies the force (gross sliding).
+///
+/// With `held` cells, those are put on their rims, `q_i = b_i z_i / |z_i|`,
+/// and only the others shift by λ: a point of the feasible set, not the
+/// nearest one. The conjugate gradient holds the slip cells it moved along
+/// their rims (see [`cg_disc`]); `None` when the other cells cannot carry
+/// the force (the caller then projects exactly).
 fn project(
     (zx, zy): (&[f64], &[f64]),
     set: &Feasible,
     lambda: &mut [f64; 2],
     (qx, qy): (&mut [f64], &mut [f64]),
+    held: Option<&[bool]>,
 ) -> Option<()> {
     let Feasible {
         cells,
@@ -134,9 +143,18 @@ fn project(
             let (mut f, mut j) = ([0.0; 2], [0.0; 3]);
             for &i in part.list() {
                 let k = i - part.start;
+                let b = set.bound(i);
+                if held.is_some_and(|h| h[i]) {
+                    let w = norm(zx[i], zy[i]);
+                    let s = if w > 0.0 { b / w } else { 0.0 };
+                    qx[k] = s * zx[i];
+                    qy[k] = s * zy[i];
+                    f[0] += qx[k];
+                    f[1] += qy[k];
+                    continue;
+                }
                 let (wx, wy) = (zx[i] + l[0], zy[i] + l[1]);
                 let w = norm(wx, wy);
-                let b = set.bound(i);
                 if w <= b {
                     qx[k] = wx;
                     qy[k] = wy;
@@ -389,7 +407,29 @@ fn on_grid_taking(
     let gross = || SolverError::GrossSliding {
         detail: "no traction field satisfies both the friction discs and the force".into(),
     };
-    project((&zx, &zy), &set, &mut lambda, (&mut qx, &mut qy)).ok_or_else(gross)?;
+    // The start's cells on their rims stay there: a warm start's tractions
+    // (the last coupling pass's, rescaled to the new pressure, or the last
+    // increment's) meet the new force by shifting the others. Shifted too,
+    // slip cells at the contact's edge fell inside their discs by a
+    // fraction of λ and started as stick cells slipping by 0.3 |δt|
+    // (Table 1a coupled at 1024²: a pass that started 4e-6 from the
+    // tolerance took 31 iterations).
+    let held: Vec<bool> = (0..len)
+        .map(|i| p[i] > 0.0 && on_rim(zx[i], zy[i], set.bound(i)))
+        .collect();
+    if project(
+        (&zx, &zy),
+        &set,
+        &mut lambda,
+        (&mut qx, &mut qy),
+        Some(&held),
+    )
+    .is_none()
+    {
+        lambda = [0.0; 2];
+        project((&zx, &zy), &set, &mut lambda, (&mut qx, &mut qy), None).ok_or_else(gross)?;
+    }
+    drop(held);
 
     let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
     let mut stick = vec![false; len];
@@ -451,7 +491,7 @@ fn on_grid_taking(
             zx[i] = yx[i] - step * sx[i];
             zy[i] = yy[i] - step * sy[i];
         }
-        project((&zx, &zy), &set, &mut lambda, (&mut px, &mut py)).ok_or_else(gross)?;
+        project((&zx, &zy), &set, &mut lambda, (&mut px, &mut py), None).ok_or_else(gross)?;
         // Gradient mapping residual, relative to the rigid shift.
         let shift_norm = (lambda[0].hypot(lambda[1]) / step)
             .max(prob.slip_floor)
@@ -625,7 +665,6 @@ fn cg_disc(
     let (cells, chunks, threads) = (set.cells, set.chunks, set.threads);
     let bound = |i: usize| set.bound(i);
     let len = qx.len();
-    let on_bound = |qx: f64, qy: f64, b: f64| norm(qx, qy) >= (1.0 - 1e-12) * b;
     // The cells' elastic stiffness in the preconditioner, m/Pa: a cell's own
     // compliance for the first step, then 1/τ of the last step.
     let mut stiffness = op.tangential_self();
@@ -638,11 +677,13 @@ fn cg_disc(
     // Stick set of the current tractions: here, then after each projection.
     let mut stick = vec![false; len];
     for &i in cells {
-        stick[i] = !on_bound(qx[i], qy[i], bound(i));
+        stick[i] = !on_rim(qx[i], qy[i], bound(i));
     }
     // This iteration's `SlipCell` of each slip cell, per piece of `chunks`
     // in the order of its cells (the later passes walk them in that order).
     let mut rims: Vec<Vec<SlipCell>> = (0..chunks.count()).map(|_| Vec::new()).collect();
+    // The slip cells each move holds on their rims (see the projection).
+    let mut held = vec![false; len];
     let mut rz_old = 1.0;
     let mut conj = false;
     // The slip field in (ux, uy) is exact (`fresh`) or updated since `age` moves.
@@ -900,41 +941,59 @@ fn cg_disc(
             .into_iter()
             .zip(chunks.split(zx))
             .zip(chunks.split(zy))
+            .zip(chunks.split(&mut held))
             .zip(rims.iter())
             .collect();
-        threads.chunked(chunks, items, |((((part, dqx, dqy), zx), zy), rims)| {
-            let mut slip = rims.iter();
-            for &i in part.list() {
-                let j = i - part.start;
-                dqx[j] = q.0[i];
-                dqy[j] = q.1[i];
-                zx[j] = q.0[i] - tau * v.0[i];
-                zy[j] = q.1[i] - tau * v.1[i];
-                if !stick[i] {
-                    let cell = slip.next().expect("one per slip cell");
-                    let (n, k) = (cell.n, cell.k);
-                    let (wx, wy) = (u.0[i] - d[0], u.1[i] - d[1]);
-                    if k == 0.0 {
-                        zx[j] = q.0[i] - tau * wx;
-                        zy[j] = q.1[i] - tau * wy;
-                    } else {
+        threads.chunked(
+            chunks,
+            items,
+            |(((((part, dqx, dqy), zx), zy), held), rims)| {
+                let mut slip = rims.iter();
+                for &i in part.list() {
+                    let j = i - part.start;
+                    dqx[j] = q.0[i];
+                    dqy[j] = q.1[i];
+                    zx[j] = q.0[i] - tau * v.0[i];
+                    zy[j] = q.1[i] - tau * v.1[i];
+                    held[j] = false;
+                    if !stick[i] {
+                        let cell = slip.next().expect("one per slip cell");
+                        let (n, k) = (cell.n, cell.k);
+                        let (wx, wy) = (u.0[i] - d[0], u.1[i] - d[1]);
                         let along = wx * n[0] + wy * n[1];
-                        if along > 0.0 {
+                        if k == 0.0 {
+                            zx[j] = q.0[i] - tau * wx;
+                            zy[j] = q.1[i] - tau * wy;
+                        } else if along > 0.0 {
                             zx[j] -= tau * along * n[0];
                             zy[j] -= tau * along * n[1];
                         }
+                        held[j] = along <= 0.0;
                     }
                 }
-            }
-        });
+            },
+        );
         stiffness = 1.0 / tau;
-        // Exact projection onto discs ∩ force (λ ≈ 0 when nothing is clipped).
+        // Projection onto discs ∩ force, the slip cells that moved along
+        // their rims held there (λ shifts the stick cells and the released
+        // ones): λ is not exactly zero after such a move, and shifted with
+        // the rest, slip cells at the contact's edge fell inside their
+        // discs, were taken as stick cells slipping by 0.3 |δt| and
+        // restarted the conjugacy (Table 1a coupled, closing solves of 27
+        // and 31 iterations at 512² and 1024² from 4e-6 of the tolerance;
+        // with them held, 1 to 3: 128 → 98 and 136 → 104 tangential
+        // iterations, docs/performance.md). The exact projection if the
+        // other cells cannot carry the force.
         let mut l = [0.0; 2];
-        project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy)).ok_or_else(|| {
-            SolverError::GrossSliding {
-                detail: "no traction field satisfies both the friction discs and the force".into(),
-            }
-        })?;
+        if project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy), Some(&held)).is_none() {
+            l = [0.0; 2];
+            project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy), None).ok_or_else(|| {
+                SolverError::GrossSliding {
+                    detail: "no traction field satisfies both the friction discs and the force"
+                        .into(),
+                }
+            })?;
+        }
         // The new stick set, whether a cell was released into it, and Δq of
         // the move.
         let q = (&*qx, &*qy);
@@ -947,7 +1006,7 @@ fn cg_disc(
             let mut released = false;
             for &i in part.list() {
                 let j = i - part.start;
-                let sticks = !on_bound(q.0[i], q.1[i], bound(i));
+                let sticks = !on_rim(q.0[i], q.1[i], bound(i));
                 released |= sticks && !stick[j];
                 stick[j] = sticks;
                 dqx[j] = q.0[i] - dqx[j];
@@ -1103,6 +1162,13 @@ impl SlipCell {
     fn t(&self) -> [f64; 2] {
         [-self.n[1], self.n[0]]
     }
+}
+
+/// Whether a traction `(qx, qy)` is on the rim of its friction disc of
+/// radius `b` (to 1e-12 of `b`): a slip cell of the conjugate gradient.
+#[inline]
+fn on_rim(qx: f64, qy: f64, b: f64) -> bool {
+    norm(qx, qy) >= (1.0 - 1e-12) * b
 }
 
 /// The solution of the 2x2 system `a x = b` by Cramer's rule, or `None`
