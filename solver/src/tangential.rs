@@ -1050,7 +1050,9 @@ struct StickPrecond<'a> {
 /// Jacobi): 1024² 37, 50, 70, 79, 102 / 111, 113, 105, 111, 76 (Fourier
 /// 338 in all against 516); 2048² 56, 186, 253, 343, 1694 / 125, 177, 109,
 /// 125, 117 (2532 against 653: the Fourier-preconditioned iteration degrades
-/// as the stick zone shrinks, cause not found). Both grids have the same
+/// as the stick zone shrinks; since the conjugate gradient holds its slip
+/// cells on their rims, 1233 against 610: half the cause was rim cells
+/// taken for stick cells, the rest not found). Both grids have the same
 /// geometry in cells (no window), so it is the resolution that differs.
 /// At 256² and 512² (fretting, 60 increments) Fourier halves the iterations
 /// (docs/performance.md, round 3).
