@@ -116,7 +116,7 @@ impl<'a> Feasible<'a> {
 /// and only the others shift by λ: a point of the feasible set, not the
 /// nearest one. The conjugate gradient holds the slip cells it moved along
 /// their rims (see [`cg_disc`]); `None` when the other cells cannot carry
-/// the force (the caller then projects exactly).
+/// the force ([`project_holding`] then projects exactly).
 fn project(
     (zx, zy): (&[f64], &[f64]),
     set: &Feasible,
@@ -223,6 +223,30 @@ fn project(
         Some(())
     } else {
         None
+    }
+}
+
+/// [`project`] holding the `held` cells on their rims, or the exact
+/// projection (from λ = 0) where the other cells cannot carry the force;
+/// gross sliding if neither exists.
+fn project_holding(
+    z: (&[f64], &[f64]),
+    set: &Feasible,
+    lambda: &mut [f64; 2],
+    (qx, qy): (&mut [f64], &mut [f64]),
+    held: &[bool],
+) -> Result<(), SolverError> {
+    if project(z, set, lambda, (&mut *qx, &mut *qy), Some(held)).is_some() {
+        return Ok(());
+    }
+    *lambda = [0.0; 2];
+    project(z, set, lambda, (qx, qy), None).ok_or_else(gross_sliding)
+}
+
+/// The error of a force no traction field within the discs can carry.
+fn gross_sliding() -> SolverError {
+    SolverError::GrossSliding {
+        detail: "no traction field satisfies both the friction discs and the force".into(),
     }
 }
 
@@ -404,9 +428,6 @@ fn on_grid_taking(
         }
     }
     let mut lambda = [0.0; 2];
-    let gross = || SolverError::GrossSliding {
-        detail: "no traction field satisfies both the friction discs and the force".into(),
-    };
     // The start's cells on their rims stay there: a warm start's tractions
     // (the last coupling pass's, rescaled to the new pressure, or the last
     // increment's) meet the new force by shifting the others. Shifted too,
@@ -417,18 +438,7 @@ fn on_grid_taking(
     let held: Vec<bool> = (0..len)
         .map(|i| p[i] > 0.0 && on_rim(zx[i], zy[i], set.bound(i)))
         .collect();
-    if project(
-        (&zx, &zy),
-        &set,
-        &mut lambda,
-        (&mut qx, &mut qy),
-        Some(&held),
-    )
-    .is_none()
-    {
-        lambda = [0.0; 2];
-        project((&zx, &zy), &set, &mut lambda, (&mut qx, &mut qy), None).ok_or_else(gross)?;
-    }
+    project_holding((&zx, &zy), &set, &mut lambda, (&mut qx, &mut qy), &held)?;
     drop(held);
 
     let (mut sx, mut sy) = (vec![0.0; len], vec![0.0; len]);
@@ -491,7 +501,8 @@ fn on_grid_taking(
             zx[i] = yx[i] - step * sx[i];
             zy[i] = yy[i] - step * sy[i];
         }
-        project((&zx, &zy), &set, &mut lambda, (&mut px, &mut py), None).ok_or_else(gross)?;
+        project((&zx, &zy), &set, &mut lambda, (&mut px, &mut py), None)
+            .ok_or_else(gross_sliding)?;
         // Gradient mapping residual, relative to the rigid shift.
         let shift_norm = (lambda[0].hypot(lambda[1]) / step)
             .max(prob.slip_floor)
@@ -985,15 +996,7 @@ fn cg_disc(
         // iterations, docs/performance.md). The exact projection if the
         // other cells cannot carry the force.
         let mut l = [0.0; 2];
-        if project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy), Some(&held)).is_none() {
-            l = [0.0; 2];
-            project((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy), None).ok_or_else(|| {
-                SolverError::GrossSliding {
-                    detail: "no traction field satisfies both the friction discs and the force"
-                        .into(),
-                }
-            })?;
-        }
+        project_holding((&*zx, &*zy), set, &mut l, (&mut *qx, &mut *qy), &held)?;
         // The new stick set, whether a cell was released into it, and Δq of
         // the move.
         let q = (&*qx, &*qy);
