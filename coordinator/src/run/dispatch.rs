@@ -12,7 +12,7 @@ use anyhow::bail;
 use protocol::{CaseAssignment, Expected, Failure, ResultHeader, ToCoord, ToWorker};
 use worker::WireScalars;
 
-use super::exchange::{unix_ns, Exchange, Request};
+use super::exchange::{unix_ns, Exchange, Next, Request};
 use super::journal::Outcome;
 use super::output;
 use super::progress::Progress;
@@ -126,38 +126,18 @@ impl<'a> Dispatch<'a> {
                 self.check_liveness(ex, sup, rec)?;
             }
             self.serve_held(ex, rec)?;
-            if rec.plan().remaining() == 0 {
-                let finished = *finished_at.get_or_insert_with(Instant::now);
-                return self.await_exits(ex, sup, rec, finished);
+            if rec.plan().remaining() > 0 {
+                return Ok(Next::Within(Duration::MAX));
             }
-            Ok(false)
+            // Every case recorded: wait for the workers' exits, looked for
+            // every EXIT_POLL (requests still get their `Done`).
+            let finished = *finished_at.get_or_insert_with(Instant::now);
+            Ok(if self.all_exited(sup) || finished.elapsed() > EXIT_GRACE {
+                Next::Done
+            } else {
+                Next::Within(EXIT_POLL)
+            })
         })
-    }
-
-    /// After the last record: whether every worker has exited (or had
-    /// [`EXIT_GRACE`] since `finished`), looked for every [`EXIT_POLL`] for
-    /// up to one [`TICK`], answering what comes in meanwhile (every request
-    /// now gets `Done`). `false` hands back to the wait set, whose tick
-    /// keeps the liveness checks going.
-    fn await_exits(
-        &mut self,
-        ex: &Exchange,
-        sup: &mut Supervisor,
-        rec: &mut Recorder,
-        finished: Instant,
-    ) -> anyhow::Result<bool> {
-        let until = Instant::now() + TICK;
-        loop {
-            if self.all_exited(sup) || finished.elapsed() > EXIT_GRACE {
-                return Ok(true);
-            }
-            if Instant::now() >= until {
-                return Ok(false);
-            }
-            std::thread::sleep(EXIT_POLL);
-            self.drain(ex, rec)?;
-            self.serve_held(ex, rec)?;
-        }
     }
 
     fn all_exited(&self, sup: &mut Supervisor) -> bool {

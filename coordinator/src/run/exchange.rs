@@ -58,6 +58,15 @@ pub fn unix_ns() -> u64 {
 #[error("interrupted; the journal keeps what was recorded (use --resume)")]
 pub struct Interrupted;
 
+/// What a step of [`Exchange::wait_loop`] asks for next.
+pub enum Next {
+    /// End the loop.
+    Done,
+    /// Wait again, for a notification or the tick, but at most this long
+    /// (`Duration::MAX`: the tick alone bounds it).
+    Within(Duration),
+}
+
 /// The IPC endpoints of one run.
 pub struct Exchange<'a> {
     run_id: &'a str,
@@ -120,13 +129,14 @@ impl<'a> Exchange<'a> {
     }
 
     /// Wake on every worker notification and at least every `tick`, calling
-    /// `step` each time until it returns `true`. A termination request
-    /// (Ctrl-C, SIGTERM) ends the loop with an error; other signals (a
-    /// pause and resume) do not.
+    /// `step` each time until it returns [`Next::Done`]; [`Next::Within`]
+    /// bounds the next wait further. A termination request (Ctrl-C,
+    /// SIGTERM) ends the loop with an error; other signals (a pause and
+    /// resume) do not.
     pub fn wait_loop(
         &self,
         tick: Duration,
-        mut step: impl FnMut() -> anyhow::Result<bool>,
+        mut step: impl FnMut() -> anyhow::Result<Next>,
     ) -> anyhow::Result<()> {
         let waitset = WaitSetBuilder::new()
             .create::<ipc::Service>()
@@ -137,8 +147,11 @@ impl<'a> Exchange<'a> {
         let _tick = waitset
             .attach_interval(tick)
             .map_err(|e| anyhow!("cannot attach interval: {e:?}"))?;
+        let mut within = Duration::MAX;
         loop {
-            match waitset.wait_and_process_once(|_| CallbackProgression::Continue) {
+            match waitset
+                .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, within)
+            {
                 Ok(WaitSetRunResult::TerminationRequest) => return Err(Interrupted.into()),
                 // Any other signal cut the wait short: SIGCONT after a pause
                 // (Ctrl-Z and `fg`, a debugger, `scontrol suspend`/`resume`)
@@ -149,8 +162,9 @@ impl<'a> Exchange<'a> {
                 Err(e) => bail!("waiting failed: {e:?}"),
             }
             let _ = self.listener.try_wait(|_| {});
-            if step()? {
-                return Ok(());
+            match step()? {
+                Next::Done => return Ok(()),
+                Next::Within(d) => within = d,
             }
         }
     }
