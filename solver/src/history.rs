@@ -15,6 +15,7 @@ use crate::normal::{NormalProblem, NormalSolution};
 use crate::operator::{X, Y, Z};
 use crate::results::{apparent_radius, friction_reserve};
 use crate::spec::{CaseSpec, LoadHistory};
+use crate::surface::Terrain;
 
 /// How the dissipated energy is computed.
 pub const DISSIPATION_DEFINITION: &str = "energy dissipated by slip, sum over increments and cells of (q_prev + q)/2 . (delta_t increment - u increment) dA, q the shear tractions and u the total tangential surface displacement (trapezoidal rule for the integral of q . ds, ds the slip increment of the substrate relative to the sphere); per cycle: over the last two segments that return to the same turning point";
@@ -161,7 +162,7 @@ pub(crate) fn solve_history(
     res: &mut Resident,
     spec: &CaseSpec,
     history: &LoadHistory,
-    h0: &[f64],
+    (h0, terrain): (&[f64], &Terrain),
     normal0: NormalSolution,
     check: impl Fn(&[f64]) -> Result<(), SolverError>,
 ) -> Result<HistoryState, SolverError> {
@@ -204,10 +205,8 @@ pub(crate) fn solve_history(
     let mut normal_iterations = last.normal_iterations;
     let (mut tangential_iterations, mut coupling_iterations) = (0, 0);
     // The surface's heights and cover (for the areas and stick radius of
-    // every row), once.
-    let heights = spec.surface.heights(&grid);
-    let cover = res.operator.cover().map(<[f64]>::to_vec);
-    let terrain = (&heights[..], cover.as_deref());
+    // every row).
+    let terrain = (&terrain.heights[..], terrain.cover.as_deref());
     let mut rows = vec![row(
         spec,
         terrain,

@@ -9,7 +9,9 @@ use std::collections::HashMap;
 use crate::error::SolverError;
 use crate::grid::Grid;
 use crate::material::Material;
-use crate::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
+use crate::normal::{
+    solve_normal, solve_normal_from_rest, NormalCache, NormalProblem, NormalSolution,
+};
 use crate::operator::{Operator, Spectra};
 use crate::parallel::Threads;
 use crate::progress::Stage;
@@ -169,6 +171,15 @@ impl Resident {
     /// [`solve_normal`] on this bundle.
     pub fn solve_normal(&mut self, prob: &NormalProblem) -> Result<NormalSolution, SolverError> {
         solve_normal(&mut self.operator, &mut self.normal, prob)
+    }
+
+    /// [`solve_normal_from_rest`] on this bundle: the contact a case starts
+    /// from, kept for the next case that starts from the same one.
+    pub fn solve_normal_from_rest(
+        &mut self,
+        prob: &NormalProblem,
+    ) -> Result<NormalSolution, SolverError> {
+        solve_normal_from_rest(&mut self.operator, &mut self.normal, prob)
     }
 
     /// [`crate::tangential_displacement::solve_displacement`] on this bundle.

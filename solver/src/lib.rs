@@ -115,4 +115,4 @@ pub use results::{
     APPARENT_RADIUS_DEFINITION_MOMENTS, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
 pub use spec::{CaseSpec, Load, LoadHistory, Numerics, Radii, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
-pub use surface::{Island, LatticeKind, Sampling, Surface, MIN_COVER};
+pub use surface::{Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER};

@@ -14,6 +14,7 @@ use crate::history::HistoryOutput;
 use crate::normal::NormalReport;
 use crate::operator::{Operator, X, Y, Z};
 use crate::spec::{CaseSpec, Load, Radii, MIN_RESOLVED_CELLS};
+use crate::surface::Terrain;
 use crate::tangential::{TangentialReport, TangentialSolution};
 
 /// The scalars of one solved case.
@@ -266,6 +267,7 @@ pub fn calibrate_on_flat(s: &mut CaseScalars, flat: &CaseScalars, load: &Load) {
 /// are not checked against the grid.
 pub(crate) fn reduce(
     spec: &CaseSpec,
+    terrain: &Terrain,
     op: &mut Operator,
     state: ContactState,
     started: std::time::Instant,
@@ -307,10 +309,8 @@ pub(crate) fn reduce(
 
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
     let stick_in_contact: Vec<bool> = (0..len).map(|i| contact[i] && stick[i]).collect();
-    // A cut cell contributes its covered part (`cover`, set on the operator
-    // for this case by the driver).
-    let cover = op.cover().map(<[f64]>::to_vec);
-    let cover = cover.as_deref();
+    // A cut cell contributes its covered part.
+    let cover = terrain.cover.as_deref();
     let contact_area = covered_area(&contact, cover, da);
     let stick_area = covered_area(&stick_in_contact, cover, da);
     // The paper's radii (whole cells) decide what the grid resolves, as
@@ -353,9 +353,7 @@ pub(crate) fn reduce(
     } else {
         [1.0, 0.0]
     };
-    // Recomputed here rather than held through the solve (one field less at
-    // the memory peak; a cheap pass over the cells).
-    let heights = spec.surface.heights(&grid);
+    let heights = &terrain.heights;
     let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let base_contact = !matches!(spec.surface, crate::surface::Surface::Flat)
         && (0..len).any(|i| contact[i] && heights[i] < top);

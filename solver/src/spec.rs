@@ -381,7 +381,12 @@ impl CaseSpec {
     /// surface at each cell, shifted so that its minimum is zero (δz is then
     /// the approach from first touch).
     pub fn initial_gap(&self) -> Vec<f64> {
-        let heights = self.surface.heights(&self.grid);
+        self.initial_gap_on(&self.surface.heights(&self.grid))
+    }
+
+    /// [`CaseSpec::initial_gap`] over the surface's `heights` (from
+    /// [`crate::Surface::terrain`], made once per case).
+    pub fn initial_gap_on(&self, heights: &[f64]) -> Vec<f64> {
         let grid = self.grid;
         let n = grid.n;
         let r = self.load.indenter_radius_m;

@@ -116,6 +116,49 @@ fn positive(field: &str, v: f64, what: &str) -> Result<(), SolverError> {
     crate::error::positive(field, v, what, " m")
 }
 
+/// A surface sampled on a grid ([`Surface::terrain`]): each cell's height
+/// above the base and, where an edge cuts cells, every cell's cover.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Terrain {
+    /// [`Surface::heights`].
+    pub heights: Vec<f64>,
+    /// [`Surface::cover`].
+    pub cover: Option<Vec<f64>>,
+}
+
+/// An area-sampled pattern's cell heights from the fractions on its upper
+/// level: the upper level wherever at least [`MIN_COVER`] of a cell is on it.
+fn levels(upper: &[f64], height: f64) -> Vec<f64> {
+    upper
+        .iter()
+        .map(|&f| {
+            if f >= MIN_COVER {
+                height.max(0.0)
+            } else {
+                height.min(0.0)
+            }
+        })
+        .collect()
+}
+
+/// The cover from the fractions on the upper level: the fraction on the cut
+/// cells, 1 elsewhere; `None` when no cell is cut.
+fn cover_of(upper: Vec<f64>) -> Option<Vec<f64>> {
+    let mut cut = false;
+    let cover: Vec<f64> = upper
+        .into_iter()
+        .map(|f| {
+            if (MIN_COVER..1.0).contains(&f) {
+                cut = true;
+                f
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    cut.then_some(cover)
+}
+
 impl Surface {
     /// Checks that the surface is geometrically possible on an `n x n` grid.
     pub fn validate(&self, n: usize) -> Result<(), SolverError> {
@@ -274,17 +317,47 @@ impl Surface {
                 }
             }
             Surface::Lattice { height, .. } | Surface::Stripes { height, .. } => {
-                let upper = self.upper_fraction(grid, *height);
-                for (h, &f) in h.iter_mut().zip(&upper) {
-                    *h = if f >= MIN_COVER {
-                        height.max(0.0)
-                    } else {
-                        height.min(0.0)
-                    };
-                }
+                return levels(&self.upper_fraction(grid, *height), *height);
             }
         }
         h
+    }
+
+    /// The heights and the cover of every cell ([`Surface::heights`],
+    /// [`Surface::cover`]), the fractions of an area-sampled pattern
+    /// integrated once for both: what a case needs of its surface.
+    pub fn terrain(&self, grid: &Grid) -> Terrain {
+        match self.area_height() {
+            Some(height) => {
+                let upper = self.upper_fraction(grid, height);
+                Terrain {
+                    heights: levels(&upper, height),
+                    cover: cover_of(upper),
+                }
+            }
+            None => Terrain {
+                heights: self.heights(grid),
+                cover: None,
+            },
+        }
+    }
+
+    /// The pattern height of an area-sampled pattern (`None` for every other
+    /// surface: whole cells).
+    fn area_height(&self) -> Option<f64> {
+        match self {
+            Surface::Lattice {
+                height,
+                sampling: Sampling::Area,
+                ..
+            }
+            | Surface::Stripes {
+                height,
+                sampling: Sampling::Area,
+                ..
+            } => Some(*height),
+            _ => None,
+        }
     }
 
     /// The fraction of each cell's area at the level [`Surface::heights`]
@@ -298,33 +371,8 @@ impl Surface {
     /// more compliant under its own load
     /// ([`crate::operator::cut_self_factor`], `docs/physics-choices.md`).
     pub fn cover(&self, grid: &Grid) -> Option<Vec<f64>> {
-        let height = match self {
-            Surface::Lattice {
-                height,
-                sampling: Sampling::Area,
-                ..
-            }
-            | Surface::Stripes {
-                height,
-                sampling: Sampling::Area,
-                ..
-            } => *height,
-            _ => return None,
-        };
-        let mut cut = false;
-        let cover: Vec<f64> = self
-            .upper_fraction(grid, height)
-            .into_iter()
-            .map(|f| {
-                if (MIN_COVER..1.0).contains(&f) {
-                    cut = true;
-                    f
-                } else {
-                    1.0
-                }
-            })
-            .collect();
-        cut.then_some(cover)
+        let height = self.area_height()?;
+        cover_of(self.upper_fraction(grid, height))
     }
 
     /// The fraction of each cell's area on the pattern's upper level: the
@@ -529,6 +577,49 @@ fn lattice_area_in(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The terrain a case reads is the surface's heights and cover, to the
+    /// bit, for every kind of surface and sampling.
+    #[test]
+    fn the_terrain_is_the_heights_and_the_cover() {
+        let grid = Grid {
+            n: 96,
+            dx: 1.3e-6,
+            dy: 1.3e-6,
+        };
+        let circle = |sampling, height| Surface::Lattice {
+            island: Island::Circle { diameter: 23e-6 },
+            pitch: 41e-6,
+            height,
+            offset: [2e-6, -5e-6],
+            lattice: LatticeKind::Hexagonal,
+            sampling,
+        };
+        let stripes = |sampling| Surface::Stripes {
+            width: 9e-6,
+            pitch: 25e-6,
+            height: 0.5e-6,
+            angle_deg: 30.0,
+            offset: 1e-6,
+            sampling,
+        };
+        let surfaces = [
+            Surface::Flat,
+            circle(Sampling::Area, 1e-6),
+            circle(Sampling::Area, -1e-6),
+            circle(Sampling::Centre, 1e-6),
+            stripes(Sampling::Area),
+            stripes(Sampling::Centre),
+        ];
+        let mut cut = 0;
+        for s in &surfaces {
+            let t = s.terrain(&grid);
+            assert_eq!(t.heights, s.heights(&grid), "{s:?}");
+            assert_eq!(t.cover, s.cover(&grid), "{s:?}");
+            cut += usize::from(t.cover.is_some());
+        }
+        assert_eq!(cut, 3, "the area-sampled patterns have cut cells");
+    }
 
     #[test]
     fn sampled_coverage_matches_the_analytic_density() {
