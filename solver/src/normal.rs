@@ -729,24 +729,35 @@ mod tests {
     use crate::influence::isotropic_cell;
     use crate::operator::{Grid, Operator};
 
-    /// The contact from rest kept between cases is returned only for the
-    /// same problem on the same cover, and is then the fresh solve's bits;
-    /// another load or another cover is solved.
-    #[test]
-    fn a_contact_from_rest_is_reused_for_the_same_problem_only() {
-        let n = 64;
-        let (e, nu, r, load) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64, 20.0_f64);
-        let a = (3.0 * load * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
+    /// Load of [`hertz`]'s contact, N.
+    const HERTZ_LOAD: f64 = 20.0;
+
+    /// A steel half-space on `n x n` cells spanning 4.5 Hertz radii under
+    /// [`HERTZ_LOAD`] from a 18 mm sphere, and the sphere's separation.
+    fn hertz(n: usize) -> (Operator, Vec<f64>) {
+        let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
+        let a = (3.0 * HERTZ_LOAD * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
         let d = 4.5 * a / n as f64;
         let grid = Grid { n, dx: d, dy: d };
         let g = e / (2.0 * (1.0 + nu));
-        let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
-        let h: Vec<f64> = (0..grid.len())
+        let op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
+        let h = (0..grid.len())
             .map(|i| {
                 let (x, y) = (grid.x(i % n), grid.y(i / n));
                 (x * x + y * y) / (2.0 * r)
             })
             .collect();
+        (op, h)
+    }
+
+    /// The contact from rest kept between cases is returned only for the
+    /// same problem on the same cover, and is then the fresh solve's bits;
+    /// another load or another cover is solved.
+    #[test]
+    fn a_contact_from_rest_is_reused_for_the_same_problem_only() {
+        let (n, load) = (64, HERTZ_LOAD);
+        let (mut op, h) = hertz(n);
+        let grid = op.grid();
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let prob = NormalProblem::new(&h, load);
         let mut own = NormalCache::new(&mut op);
@@ -790,19 +801,8 @@ mod tests {
     /// preconditioned iteration needs far fewer fine iterations.
     #[test]
     fn nested_and_preconditioned_solves_reach_the_plain_solution() {
-        let n = 128;
-        let (e, nu, r, load) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64, 20.0_f64);
-        let a = (3.0 * load * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
-        let d = 4.5 * a / n as f64;
-        let grid = Grid { n, dx: d, dy: d };
-        let g = e / (2.0 * (1.0 + nu));
-        let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, grid.dx, grid.dy));
-        let h: Vec<f64> = (0..grid.len())
-            .map(|i| {
-                let (x, y) = (grid.x(i % n), grid.y(i / n));
-                (x * x + y * y) / (2.0 * r)
-            })
-            .collect();
+        let load = HERTZ_LOAD;
+        let (mut op, h) = hertz(128);
         let mut cache = NormalCache::new(&mut op);
         let mut runs = Vec::new();
         for (nested, precondition) in [(false, false), (true, false), (false, true), (true, true)] {
