@@ -243,7 +243,7 @@ pub fn cut_self_factor(cover: f64) -> f64 {
 }
 
 /// The smallest cover whose own compliance [`cut_self_factor`] follows:
-/// a sliver cell (2–10 % covered) gets the factor of 10 % (9.4) instead of
+/// a sliver cell (2–10 % covered) gets the factor of 10 % (13.6) instead of
 /// up to 70. Such a cell carries almost nothing, but its 1/cover compliance
 /// made the tangential conjugate gradient's stick block ill-conditioned:
 /// the quick sweep's patterned cases took 4946 tangential iterations (2438
@@ -895,6 +895,20 @@ mod tests {
                 ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.3
             })
             .collect()
+    }
+
+    /// The cut cells' factor: a whole cell's compliance at cover 1, the
+    /// straight-edge form `(1 + β (1 − c)) / c` above the floor, the floor's
+    /// value below it.
+    #[test]
+    fn the_cut_factor_is_whole_at_full_cover_and_floored_for_slivers() {
+        assert_eq!(cut_self_factor(1.0), 1.0);
+        let half = cut_self_factor(0.5);
+        assert!((half - (1.0 + 0.5 * CUT_CELL_BETA) / 0.5).abs() < 1e-15);
+        let floor = cut_self_factor(CUT_COVER_FLOOR);
+        assert!((floor - 13.6).abs() < 1e-12, "{floor}");
+        assert_eq!(cut_self_factor(0.02), floor);
+        assert!(cut_self_factor(0.3) < floor && cut_self_factor(0.3) > half);
     }
 
     /// A cell's own tangential compliance, from the spectra, is the mean of
