@@ -72,7 +72,10 @@ pub struct CaseScalars {
     pub tangential_force_n: [f64; 2],
     /// All loops converged.
     pub converged: bool,
-    /// Normal CG iterations, summed over coupling iterations.
+    /// Normal CG iterations, summed over coupling iterations, with those
+    /// of the contact from rest even when the worker reused it from an
+    /// earlier case ([`crate::normal::solve_normal_from_rest`]): the same
+    /// count whichever worker ran the case.
     pub normal_iterations: usize,
     /// Tangential iterations, summed over coupling iterations.
     pub tangential_iterations: usize,
