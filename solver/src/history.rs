@@ -204,9 +204,6 @@ pub(crate) fn solve_history(
     let (mut delta_t_max, mut last_increment) = (0.0_f64, 0.0_f64);
     let mut normal_iterations = last.normal_iterations;
     let (mut tangential_iterations, mut coupling_iterations) = (0, 0);
-    // The surface's heights and cover (for the areas and stick radius of
-    // every row).
-    let terrain = (&terrain.heights[..], terrain.cover.as_deref());
     let mut rows = vec![row(
         spec,
         terrain,
@@ -389,14 +386,8 @@ struct StepSums {
     converged: bool,
 }
 
-/// The table row of a solved increment.
-/// `terrain`: the surface's heights and cover ([`crate::Surface::cover`]).
-fn row(
-    spec: &CaseSpec,
-    (heights, cover): (&[f64], Option<&[f64]>),
-    state: &ContactState,
-    sums: &StepSums,
-) -> HistoryStep {
+/// The table row of a solved increment on the surface's `terrain`.
+fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums) -> HistoryStep {
     let grid = spec.grid;
     let (len, da) = (grid.len(), grid.cell_area());
     let p = &state.p;
@@ -404,16 +395,10 @@ fn row(
     let mu = spec.load.friction;
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
     let stick: Vec<bool> = (0..len).map(|i| contact[i] && tan.stick[i]).collect();
-    let count = |v: &[bool]| covered_area(v, cover, da);
+    let count = |v: &[bool]| covered_area(v, terrain.cover.as_deref(), da);
     let stick_radius = if stick.iter().any(|&b| b) {
         let reserve = friction_reserve(mu, p, (&tan.qx, &tan.qy));
-        apparent_radius(
-            spec.numerics.radii,
-            &grid,
-            &stick,
-            &reserve,
-            (heights, cover),
-        )
+        apparent_radius(spec.numerics.radii, &grid, &stick, &reserve, terrain)
     } else {
         0.0
     };

@@ -169,7 +169,7 @@ pub const APPARENT_RADIUS_DEFINITION_CELLS: &str =
 /// The apparent radius (m) of the zone `mask` of `grid` under the
 /// definition `radii`, from its level field (the pressure on the contact,
 /// [`friction_reserve`] on the stick zone): the sub-cell hull's
-/// ([`APPARENT_RADIUS_DEFINITION`]; `terrain`: heights and cover, which
+/// ([`APPARENT_RADIUS_DEFINITION`]; the `terrain`'s heights and cover
 /// bound it at island edges) or the second moment's
 /// ([`APPARENT_RADIUS_DEFINITION_MOMENTS`]).
 pub(crate) fn apparent_radius(
@@ -177,10 +177,16 @@ pub(crate) fn apparent_radius(
     grid: &crate::grid::Grid,
     mask: &[bool],
     level: &[f64],
-    (heights, cover): (&[f64], Option<&[f64]>),
+    terrain: &Terrain,
 ) -> f64 {
     match radii {
-        Radii::Hull => equivalent_radius(subcell_hull_area(grid, mask, level, heights, cover)),
+        Radii::Hull => equivalent_radius(subcell_hull_area(
+            grid,
+            mask,
+            level,
+            &terrain.heights,
+            terrain.cover.as_deref(),
+        )),
         Radii::Moments => moment_radius(grid, mask, level),
     }
 }
@@ -368,7 +374,6 @@ pub(crate) fn reduce(
     // same two levels.
     let friction = spec.load.friction;
     let radii = spec.numerics.radii;
-    let terrain = (&heights[..], cover);
     let a_app = apparent_radius(radii, &grid, &contact, &p, terrain);
     let c_app = if has_stick_set {
         let reserve = friction_reserve(friction, &p, (&qx, &qy));
