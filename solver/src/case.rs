@@ -4,11 +4,11 @@
 //! `spec`, `kernels`, `normal`, `coupling` and `results`.
 
 use crate::error::SolverError;
-use crate::kernels::{KernelCache, Resident};
-use crate::normal::NormalProblem;
-use crate::results::{reduce, CaseOutput};
-use crate::spec::{CaseSpec, LoadHistory};
-use crate::surface::Terrain;
+use crate::model::spec::{CaseSpec, LoadHistory};
+use crate::model::surface::Terrain;
+use crate::post::results::{reduce, CaseOutput};
+use crate::solve::normal::NormalProblem;
+use crate::solve::resident::{KernelCache, Resident};
 
 /// Fails when any cell of the outermost ring carries pressure: the contact
 /// then reaches the edge of the domain and the result would be wrong.
@@ -26,7 +26,7 @@ fn check_inside(n: usize, p: &[f64]) -> Result<(), SolverError> {
 
 /// Solves one case. Its kernel comes from (and stays in) `cache`.
 pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
-    crate::progress::start_case();
+    crate::base::progress::start_case();
     spec.validate()?;
     let (res, kernel_seconds) = cache.resident(spec)?;
     // The surface on the grid, once: an area-sampled pattern's cover is
@@ -48,7 +48,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         ..NormalProblem::new(&h0, spec.load.normal_force_n)
     })?;
     check_inside(n, &normal.p)?;
-    let state = crate::coupling::solve_partial_slip(res, spec, &h0, normal)?;
+    let state = crate::solve::coupling::solve_partial_slip(res, spec, &h0, normal)?;
     check_inside(n, &state.p)?;
     reduce(
         spec,
@@ -80,9 +80,10 @@ fn solve_history_case(
         ..NormalProblem::new(h0, points[0].0)
     })?;
     check_inside(n, &normal.p)?;
-    let solved = crate::history::solve_history(res, spec, history, (h0, terrain), normal, |p| {
-        check_inside(n, p)
-    })?;
+    let solved =
+        crate::solve::history::solve_history(res, spec, history, (h0, terrain), normal, |p| {
+            check_inside(n, p)
+        })?;
     // The final state is reduced as a case under the path's last load.
     let &(p_last, f_last) = points.last().expect("validated: at least one point");
     let mut last_spec = spec.clone();

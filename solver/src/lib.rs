@@ -38,81 +38,86 @@
 //!
 //! ## Layers
 //!
-//! Each module imports only from its own layer or those before it in this
-//! list, never in a circle; a type two layers need lives in the lower one:
+//! The modules live in one folder per layer. A module imports only from its
+//! own layer (from a module listed before it) or the layers before it, never
+//! in a circle; a type two layers need lives in the lower one. The public
+//! module paths (`solver::normal`, `solver::operator`, …) are re-exports.
 //!
-//! 1. foundations: `error`, `progress`, `parallel`, `grid`, `geometry`, `cover`
-//! 2. Green's functions: `influence`, `aniso`
-//! 3. description of a case: `material`, `surface`, `presets`, `spec`
-//! 4. the operator: `fft2`, `operator`, `multilevel` (coarse tables);
-//!    `stress` (stresses below the surface, its own spectral kernels)
-//! 5. single-field solvers: `normal`; `tangential_problem` (the tangential
+//! 0. `error` (every layer's `SolverError`)
+//! 1. `base/`, foundations, no physics: `progress`, `parallel`, `grid`,
+//!    `geometry`, `cover`
+//! 2. `green/`, Green's functions: `influence`, `aniso`
+//! 3. `model/`, the description of a case: `material`, `surface`,
+//!    `presets`, `radii` (what an apparent radius is), `spec`
+//! 4. `operators/`, kernels and operators: `fft2`, `operator`, `multilevel`
+//!    (coarse tables), `stress` (depth kernels of the stresses below the
+//!    surface), `kernels` (a kernel's identity, store and build)
+//! 5. `solve/`, the solvers: `normal`; `tangential_problem` (the tangential
 //!    solve's inputs and outputs) and `fista` (the shared momentum step) →
 //!    `coarse_slip` → `window` → `tangential`, `tangential_displacement`
-//!    (the shift imposed instead of the force)
-//! 6. resident kernels: `kernels` (an operator with the caches the solvers
-//!    of layer 5 made for it, hence after them)
-//! 7. load steps: `coupling` (one step, the coupling loop), `history` (a
-//!    load path of steps)
-//! 8. results: `results` (scalars and fields of a solved state)
-//! 9. the driver: `case` (`solve_case`)
+//!    (the shift imposed instead of the force) → `resident` (an operator
+//!    with the caches those solvers made for it) → `coupling` (one load
+//!    step, the coupling loop) → `history` (a load path of steps)
+//! 6. `post/`, computed from a solution: `results` (scalars and fields),
+//!    `stress_summary` (a case's stresses and their scalars), `indentation`
+//! 7. `case`, the driver (`solve_case`)
+//!
+//! `solver/tests/layers.rs` checks the order and the absence of circles.
 
-pub mod aniso;
+mod base;
 mod case;
-pub mod coarse_slip;
-mod coupling;
-#[doc(hidden)]
-pub mod cover;
 mod error;
-#[doc(hidden)]
-pub mod fft2;
-mod fista;
-#[doc(hidden)]
-pub mod geometry;
-mod grid;
-mod history;
-pub mod indentation;
-#[doc(hidden)]
-pub mod influence;
-mod kernels;
-mod material;
-#[doc(hidden)]
-pub mod multilevel;
-pub mod normal;
-pub mod operator;
-mod parallel;
-pub mod presets;
-mod progress;
-mod results;
-mod spec;
-pub mod stress;
-pub mod stress_summary;
-mod surface;
-pub mod tangential;
-pub mod tangential_displacement;
-mod tangential_problem;
-pub mod window;
+mod green;
+mod model;
+mod operators;
+mod post;
+mod solve;
 
+#[doc(hidden)]
+pub use base::cover;
+#[doc(hidden)]
+pub use base::geometry;
+pub use green::aniso;
+#[doc(hidden)]
+pub use green::influence;
+pub use model::presets;
+#[doc(hidden)]
+pub use operators::fft2;
+#[doc(hidden)]
+pub use operators::multilevel;
+pub use operators::operator;
+pub use operators::stress;
+pub use post::indentation;
+pub use post::stress_summary;
+pub use solve::coarse_slip;
+pub use solve::normal;
+pub use solve::tangential;
+pub use solve::tangential_displacement;
+pub use solve::window;
+
+pub use base::grid::Grid;
+pub use base::parallel::Threads;
+pub use base::progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
 pub use case::solve_case;
 pub use error::SolverError;
-pub use grid::Grid;
-pub use history::{
-    HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,
-};
-pub use kernels::{
-    build_operator, build_pair_operator, persists, BuildLock, KernelCache, KernelKey, KernelStore,
-    Resident,
-};
-pub use material::{
+pub use model::material::{
     hill_average, pair_influence, Anisotropic, ElasticModel, Elasticity, Isotropic, Material,
 };
-pub use operator::{Operator, Spectra};
-pub use parallel::Threads;
-pub use progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
-pub use results::{
-    calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields,
-    APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
-    APPARENT_RADIUS_DEFINITION_MOMENTS, K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+pub use model::radii::{
+    Radii, APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
+    APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
-pub use spec::{CaseSpec, Load, LoadHistory, Numerics, Radii, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
-pub use surface::{Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER};
+pub use model::spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
+pub use model::surface::{Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER};
+pub use operators::kernels::{
+    build_operator, build_pair_operator, persists, BuildLock, KernelKey, KernelStore,
+};
+pub use operators::operator::{Operator, Spectra};
+pub use post::results::{
+    calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields, K_E_DEFINITION,
+    K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+};
+pub use solve::history::{
+    HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,
+};
+pub use solve::resident::{KernelCache, Resident};

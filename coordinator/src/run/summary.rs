@@ -146,7 +146,7 @@ pub struct RunSummary {
     /// Curve points left out because a level of their ladder did not solve.
     pub incomplete_points: usize,
     /// Per "material / surface": μa range over angle, error, resolved.
-    pub curves: BTreeMap<String, super::output::CurveSummary>,
+    pub curves: BTreeMap<String, crate::output::sweep::CurveSummary>,
     /// How K_E is obtained.
     pub k_e_definition: &'static str,
     /// By surface name, how its edges were put on the grid: `area` (the
@@ -249,12 +249,12 @@ mod tests {
     use worker::kernel_store::FileStore;
 
     /// A worker's statistics as `dispatch` takes them from its results,
-    /// whose counts are the worker's `KernelCache::builds()` (kernels made
-    /// resident, loads included) and `loads()`.
+    /// whose counts are the worker's kernels made resident (its
+    /// `KernelCache::builds() + loads()`) and `loads()`.
     fn seen_by_dispatch(cache: &KernelCache) -> WorkerSummary {
         WorkerSummary {
             cases: 1,
-            kernel_builds: cache.builds() as u64,
+            kernel_builds: (cache.builds() + cache.loads()) as u64,
             kernel_loads: cache.loads() as u64,
             died: false,
         }

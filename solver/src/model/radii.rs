@@ -1,0 +1,86 @@
+//! What the model means by an apparent radius: the definitions μa and K_E
+//! can use (`Radii`, with the text outputs state), and the radius of a zone
+//! read from its level field under each. The solvers' load histories and the
+//! results both apply them, so they live below both.
+
+use serde::{Deserialize, Serialize};
+
+use crate::base::geometry::{equivalent_radius, moment_radius, subcell_hull_area};
+use crate::base::grid::Grid;
+use crate::model::surface::Terrain;
+
+/// The definition of the apparent contact and stick radii that μa and K_E
+/// use (PHYSICS.md §7 leaves it to the product, the convex hull being the
+/// default; docs/physics-choices.md, "Reported quantities": apparent radii
+/// from second moments).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Radii {
+    /// The circle with the area of the convex hull of the contact (stick)
+    /// boundary, located between cell centres
+    /// ([`APPARENT_RADIUS_DEFINITION`]).
+    #[default]
+    Hull,
+    /// From the second moment of the pressure (of μp − |q| on the stick
+    /// cells) about its centroid, `r² = 5/2 ⟨r²⟩`
+    /// ([`APPARENT_RADIUS_DEFINITION_MOMENTS`]): exact for Hertz and
+    /// Cattaneo–Mindlin, and continuous in the solution, so that patterned
+    /// μa converges monotonically with the grid.
+    Moments,
+}
+
+impl Radii {
+    /// The definition's text, as outputs state it.
+    pub fn definition(self) -> &'static str {
+        match self {
+            Radii::Hull => APPARENT_RADIUS_DEFINITION,
+            Radii::Moments => APPARENT_RADIUS_DEFINITION_MOMENTS,
+        }
+    }
+}
+
+/// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
+/// used for `mu_a` and `k_e`) are defined.
+pub const APPARENT_RADIUS_DEFINITION: &str = "radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres: along every row and column, the zero of p^2 ((mu p - |q|)^2 for stick) extrapolated linearly outward from the two outermost cells, kept within one cell pitch (the cell face where the level does not fall outward)";
+
+/// The second-moment definition of the apparent radii (`solver.radii =
+/// "moments"`; the default is [`APPARENT_RADIUS_DEFINITION`]).
+pub const APPARENT_RADIUS_DEFINITION_MOMENTS: &str = "radius from the second moment about the centroid, r^2 = 5/2 <r^2>, of the pressure over the contact cells (of mu p - |q| over the stick cells): exact for a Hertz pressure and a Cattaneo-Mindlin stick zone, continuous in the solution";
+
+/// How the paper's radii (`contact_radius_cells_m`, `stick_radius_cells_m`,
+/// used for `mu_a_cells` and `k_e_cells`) are defined.
+pub const APPARENT_RADIUS_DEFINITION_CELLS: &str =
+    "radius of the circle with the area of the convex hull of the contact (stick) cells, each cell taken as its full square (the paper's definition)";
+
+/// The apparent radius (m) of the zone `mask` of `grid` under the
+/// definition `radii`, from its level field (the pressure on the contact,
+/// [`friction_reserve`] on the stick zone): the sub-cell hull's
+/// ([`APPARENT_RADIUS_DEFINITION`]; the `terrain`'s heights and cover
+/// bound it at island edges) or the second moment's
+/// ([`APPARENT_RADIUS_DEFINITION_MOMENTS`]).
+pub(crate) fn apparent_radius(
+    radii: Radii,
+    grid: &Grid,
+    mask: &[bool],
+    level: &[f64],
+    terrain: &Terrain,
+) -> f64 {
+    match radii {
+        Radii::Hull => equivalent_radius(subcell_hull_area(
+            grid,
+            mask,
+            level,
+            &terrain.heights,
+            terrain.cover.as_deref(),
+        )),
+        Radii::Moments => moment_radius(grid, mask, level),
+    }
+}
+
+/// The stick zone's friction reserve `(μp − |q|)⁺` per cell, Pa: the level
+/// whose zero is a Mindlin stick edge.
+pub(crate) fn friction_reserve(mu: f64, p: &[f64], (qx, qy): (&[f64], &[f64])) -> Vec<f64> {
+    (0..p.len())
+        .map(|i| (mu * p[i] - qx[i].hypot(qy[i])).max(0.0))
+        .collect()
+}

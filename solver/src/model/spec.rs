@@ -1,0 +1,509 @@
+//! What defines one contact case: material, surface, grid, load and the
+//! numerical settings, and their validation. Errors name the case's
+//! parameters (`load.normal_force_n`, `surface.pitch`, …), not config keys:
+//! a front end maps them to its own names. Solves nothing.
+
+use crate::base::grid::Grid;
+use crate::error::SolverError;
+use crate::model::material::{Elasticity, Material};
+pub use crate::model::radii::Radii;
+use crate::model::surface::Surface;
+use serde::{Deserialize, Serialize};
+
+/// Largest grid accepted (cells per side): a bound on index arithmetic and
+/// transform sizes only, far above what a machine holds (16384² needs about
+/// 130 GiB). Whether a grid fits is one rule of the front end: the estimated
+/// memory of the case against what the machine has available
+/// (`coordinator::memory`, with the estimate in its message).
+pub const MAX_GRID_POINTS: usize = 16384;
+
+/// Smallest apparent contact or stick radius reported, in cells: what a
+/// grid resolves. Part of a case's description because validation rejects a
+/// case whose Hertz radius is below it before anything is solved; the
+/// results apply the same bound to the solved radii.
+pub const MIN_RESOLVED_CELLS: f64 = 2.0;
+
+/// The sphere and what is applied to it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Load {
+    /// Sphere radius R, m.
+    pub indenter_radius_m: f64,
+    /// Normal load P, N.
+    pub normal_force_n: f64,
+    /// Coulomb friction coefficient μ.
+    pub friction: f64,
+    /// F = ratio · μ · P; 0 solves normal contact only.
+    pub tangential_ratio: f64,
+    /// Direction of the tangential force in the surface, degrees from x.
+    pub angle_deg: f64,
+}
+
+impl Load {
+    /// Tangential force vector, N.
+    pub fn tangential_force(&self) -> [f64; 2] {
+        let f = self.tangential_ratio * self.friction * self.normal_force_n;
+        let a = self.angle_deg.to_radians();
+        [f * a.cos(), f * a.sin()]
+    }
+}
+
+/// Tolerances and budgets of the solvers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Numerics {
+    /// Normal–tangential coupling on/off.
+    pub coupling: bool,
+    /// Normal solver: relative change of pressure between iterations.
+    pub tolerance: f64,
+    /// Tangential solver: KKT residual (gradient mapping) relative to |δt|.
+    pub tangential_tolerance: f64,
+    /// Iteration budget of each inner solve.
+    pub max_iterations: usize,
+    /// Relative-change tolerance of the coupling loop.
+    pub coupling_tolerance: f64,
+    /// Budget of coupling (normal ↔ tangential) iterations.
+    pub max_coupling_iterations: usize,
+    /// How the apparent radii a and c of μa (Eq. 19) are read from the
+    /// solution.
+    #[serde(default)]
+    pub radii: Radii,
+}
+
+impl Default for Numerics {
+    /// Coupled; tolerances normal 1e-10, tangential 1e-6, coupling 1e-7
+    /// (docs/physics-choices.md says why); 5000 inner and 50 coupling
+    /// iterations. The config's `[solver]` defaults are these.
+    fn default() -> Self {
+        Numerics {
+            coupling: true,
+            tolerance: 1e-10,
+            tangential_tolerance: 1e-6,
+            max_iterations: 5000,
+            coupling_tolerance: 1e-7,
+            max_coupling_iterations: 50,
+            radii: Radii::Hull,
+        }
+    }
+}
+
+/// Most increments a load history may ask for (all segments together): a
+/// bound against a typo (`steps_per_segment = 1e6`), far above the few
+/// hundred a fretting study needs.
+pub const MAX_HISTORY_STEPS: usize = 100_000;
+
+/// A load path: turning points of the normal load and of the tangential
+/// force, joined by straight lines, each segment split into
+/// `steps_per_segment` increments (a fretting loop, a proportional
+/// loading). The state before the path is frictionless normal contact under
+/// the first turning point's normal load; if the first tangential ratio is
+/// not zero, the path starts with a segment from zero force to it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoadHistory {
+    /// Turning points of F/(μP) along the case's force direction (signed:
+    /// negative is against it), P being the normal load at that point.
+    pub tangential_ratios: Vec<f64>,
+    /// Turning points of the normal load, N, one per tangential ratio;
+    /// `None`: constant, the case's `load.normal_force_n`.
+    pub normal_forces_n: Option<Vec<f64>>,
+    /// Increments per segment between turning points.
+    pub steps_per_segment: usize,
+    /// Displacement control (as fretting rigs run): the turning points of
+    /// the ball's rigid tangential shift along the force direction, m
+    /// (signed), measured from the end of the frictionless normal loading
+    /// against the far field of the substrate. When given, they replace
+    /// `tangential_ratios` (which must be empty), the force is a result, and
+    /// the contact may slide as a whole (gross slip).
+    #[serde(default)]
+    pub shifts_m: Option<Vec<f64>>,
+}
+
+impl LoadHistory {
+    /// True when the turning points are shifts of the ball (`shifts_m`).
+    pub fn displacement_controlled(&self) -> bool {
+        self.shifts_m.is_some()
+    }
+
+    /// The number of turning points given.
+    fn count(&self) -> usize {
+        self.shifts_m
+            .as_ref()
+            .map_or(self.tangential_ratios.len(), Vec::len)
+    }
+
+    /// The turning points as (P in N, the tangential target along the force
+    /// direction: F in N, or the ball's shift in m under displacement
+    /// control), starting from zero tangential force (shift).
+    pub fn turning_points(&self, load: &Load) -> Vec<(f64, f64)> {
+        let normal = |j: usize| match &self.normal_forces_n {
+            Some(v) => v[j],
+            None => load.normal_force_n,
+        };
+        let mut pts: Vec<(f64, f64)> = (0..self.count())
+            .map(|j| {
+                let p = normal(j);
+                match &self.shifts_m {
+                    Some(d) => (p, d[j]),
+                    None => (p, self.tangential_ratios[j] * load.friction * p),
+                }
+            })
+            .collect();
+        if let Some(&(p0, f0)) = pts.first() {
+            if f0 != 0.0 {
+                pts.insert(0, (p0, 0.0));
+            }
+        }
+        pts
+    }
+
+    /// Rejects impossible paths, naming `history.<key>[index]`.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        let n = self.count();
+        let key = if self.displacement_controlled() {
+            "history.shifts_m"
+        } else {
+            "history.tangential_ratios"
+        };
+        if n == 0 {
+            return Err(SolverError::invalid(
+                key,
+                "needs at least one turning point",
+            ));
+        }
+        if let Some(d) = &self.shifts_m {
+            if !self.tangential_ratios.is_empty() {
+                return Err(SolverError::invalid(
+                    "history.shifts_m",
+                    "give the turning points either as forces (tangential_ratios) or as shifts, not both",
+                ));
+            }
+            for (j, &v) in d.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(SolverError::invalid(
+                        &format!("history.shifts_m[{j}]"),
+                        format!("must be finite, got {v} m"),
+                    ));
+                }
+            }
+        }
+        for (j, &r) in self.tangential_ratios.iter().enumerate() {
+            if !r.is_finite() {
+                return Err(SolverError::invalid(
+                    &format!("history.tangential_ratios[{j}]"),
+                    format!("must be finite, got {r}"),
+                ));
+            }
+            if r.abs() >= 1.0 {
+                return Err(SolverError::invalid(
+                    &format!("history.tangential_ratios[{j}]"),
+                    format!(
+                        "|F|/μP = {} reaches or exceeds the friction limit: the sphere slides as a whole (gross sliding); keep every turning point below 1 in magnitude",
+                        r.abs()
+                    ),
+                ));
+            }
+        }
+        if let Some(v) = &self.normal_forces_n {
+            if v.len() != n {
+                return Err(SolverError::invalid(
+                    "history.normal_forces_n",
+                    format!(
+                        "has {} turning points but {key} has {n}; give one normal load per turning point",
+                        v.len()
+                    ),
+                ));
+            }
+            for (j, &p) in v.iter().enumerate() {
+                positive(
+                    &format!("history.normal_forces_n[{j}]"),
+                    p,
+                    "the normal load",
+                )?;
+            }
+        }
+        if self.steps_per_segment == 0 {
+            return Err(SolverError::invalid(
+                "history.steps_per_segment",
+                "must be at least 1",
+            ));
+        }
+        let total = self.steps_per_segment.saturating_mul(n);
+        if total > MAX_HISTORY_STEPS {
+            return Err(SolverError::invalid(
+                "history.steps_per_segment",
+                format!(
+                    "{} increments per segment over {n} turning points make {total} increments, more than {MAX_HISTORY_STEPS}",
+                    self.steps_per_segment
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Everything that defines one case.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseSpec {
+    /// Substrate material.
+    pub material: Material,
+    /// Surface topography.
+    pub surface: Surface,
+    /// The surface grid (square cells).
+    pub grid: Grid,
+    /// Sphere, loads and force direction.
+    pub load: Load,
+    /// Solver settings.
+    pub numerics: Numerics,
+    /// A load path (fretting, proportional loading); `None`: one monotonic
+    /// step of the tangential force from zero at constant normal load.
+    #[serde(default)]
+    pub history: Option<LoadHistory>,
+    /// The ball's material, its stiffness in the ball's own frame (normal
+    /// pointing into the ball, x along the substrate's x, y = z × x, i.e.
+    /// the substrate's frame turned 180° about x); `None`: a rigid ball.
+    /// The contact compliance is the sum of the two bodies' (see
+    /// [`crate::model::material::pair_influence`]).
+    #[serde(default)]
+    pub indenter: Option<Material>,
+}
+
+fn positive(param: &str, v: f64, what: &str) -> Result<(), SolverError> {
+    crate::error::positive(param, v, what, "")
+}
+
+/// Prefixes the parameter of an `Invalid` error with `prefix.`.
+fn within(prefix: &str, e: SolverError) -> SolverError {
+    match e {
+        SolverError::Invalid { field, reason } => {
+            SolverError::invalid(&format!("{prefix}.{field}"), reason)
+        }
+        other => other,
+    }
+}
+
+impl CaseSpec {
+    /// Tangential force vector, N.
+    pub fn tangential_force(&self) -> [f64; 2] {
+        self.load.tangential_force()
+    }
+
+    /// True when μa needs K_E calibrated on the flat surface of the same
+    /// material at the same angle (an anisotropic substrate or ball under a
+    /// tangential load).
+    pub fn needs_flat_calibration(&self) -> bool {
+        let anisotropic = !self.material.is_isotropic()
+            || self.indenter.as_ref().is_some_and(|m| !m.is_isotropic());
+        anisotropic && self.load.tangential_ratio > 0.0
+    }
+
+    /// The solver settings as solved: with coupling off when the pair's
+    /// normal–tangential coupling vanishes identically (an elastic ball of
+    /// the substrate's own isotropic constants, Dundurs β = 0, or two
+    /// incompressible isotropic bodies), where the coupling loop could only
+    /// repeat its first pass. A rigid ball keeps the settings as given.
+    pub fn numerics_in_effect(&self) -> Numerics {
+        let mut num = self.numerics;
+        if let (Some(ball), Elasticity::Isotropic(sub)) =
+            (&self.indenter, &self.material.elasticity)
+        {
+            if let Elasticity::Isotropic(b) = &ball.elasticity {
+                let identical = sub.youngs == b.youngs && sub.poisson == b.poisson;
+                let incompressible = sub.poisson == 0.5 && b.poisson == 0.5;
+                if identical || incompressible {
+                    num.coupling = false;
+                }
+            }
+        }
+        num
+    }
+
+    /// The contact modulus E* of the pair from the isotropic-equivalent
+    /// constants, `1/E* = Σ (1 − νᵢ²)/Eᵢ` (the substrate's plane-strain
+    /// modulus for a rigid ball): Hertz normalisation.
+    pub fn contact_modulus(&self) -> f64 {
+        let sub = self.material.equivalent.plane_strain();
+        match &self.indenter {
+            // As before balls existed (1/(1/E*) may differ from E* in the last bit).
+            None => sub,
+            Some(ball) => 1.0 / (1.0 / sub + 1.0 / ball.equivalent.plane_strain()),
+        }
+    }
+
+    /// Mindlin's K_E of the pair, `16 / (3 Σ (2 − νᵢ)/Gᵢ)` from the
+    /// isotropic-equivalent constants (the substrate's
+    /// `8E / (3(1 + ν)(2 − ν))` for a rigid ball, computed as before).
+    pub fn mindlin_k_e(&self) -> f64 {
+        match &self.indenter {
+            None => self.material.equivalent.mindlin_k_e(),
+            Some(ball) => {
+                let c = |m: &Material| (2.0 - m.equivalent.poisson) / m.equivalent.shear();
+                16.0 / (3.0 * (c(&self.material) + c(ball)))
+            }
+        }
+    }
+
+    /// The same case on the flat surface: the K_E calibration twin.
+    pub fn flat_twin(&self) -> CaseSpec {
+        CaseSpec {
+            surface: Surface::Flat,
+            ..self.clone()
+        }
+    }
+
+    /// Initial separation between sphere (parabolic profile r²/2R) and
+    /// surface at each cell, shifted so that its minimum is zero (δz is then
+    /// the approach from first touch).
+    pub fn initial_gap(&self) -> Vec<f64> {
+        self.initial_gap_on(&self.surface.heights(&self.grid))
+    }
+
+    /// [`CaseSpec::initial_gap`] over the surface's `heights` (from
+    /// [`crate::Surface::terrain`], made once per case).
+    pub fn initial_gap_on(&self, heights: &[f64]) -> Vec<f64> {
+        let grid = self.grid;
+        let n = grid.n;
+        let r = self.load.indenter_radius_m;
+        let mut h: Vec<f64> = (0..grid.len())
+            .map(|i| {
+                let (x, y) = (grid.x(i % n), grid.y(i / n));
+                (x * x + y * y) / (2.0 * r) - heights[i]
+            })
+            .collect();
+        let min = h.iter().cloned().fold(f64::INFINITY, f64::min);
+        h.iter_mut().for_each(|v| *v -= min);
+        h
+    }
+
+    /// Rejects impossible inputs with the name of the offending parameter.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        // The path first: its ratios set the case's own (the last one).
+        if let Some(h) = &self.history {
+            h.validate()?;
+        }
+        let grid = &self.grid;
+        if grid.n < 8 || grid.n > MAX_GRID_POINTS {
+            return Err(SolverError::invalid(
+                "grid.n",
+                format!(
+                    "must be between 8 and {MAX_GRID_POINTS} cells per side, got {}",
+                    grid.n
+                ),
+            ));
+        }
+        positive("grid.dx", grid.dx, "the cell size")?;
+        if grid.dy != grid.dx {
+            return Err(SolverError::invalid(
+                "grid.dy",
+                format!("cells must be square, got {} x {} m", grid.dx, grid.dy),
+            ));
+        }
+        let load = &self.load;
+        positive(
+            "load.indenter_radius_m",
+            load.indenter_radius_m,
+            "the indenter radius",
+        )?;
+        positive(
+            "load.normal_force_n",
+            load.normal_force_n,
+            "the normal load",
+        )?;
+        if !(load.friction.is_finite() && load.friction >= 0.0) {
+            return Err(SolverError::invalid(
+                "load.friction",
+                format!(
+                    "the friction coefficient must be finite and ≥ 0, got {}",
+                    load.friction
+                ),
+            ));
+        }
+        let ratio = load.tangential_ratio;
+        if !(ratio.is_finite() && ratio >= 0.0) {
+            return Err(SolverError::invalid(
+                "load.tangential_ratio",
+                format!("must be finite and ≥ 0, got {ratio}"),
+            ));
+        }
+        if ratio >= 1.0 {
+            return Err(SolverError::invalid(
+                "load.tangential_ratio",
+                format!(
+                    "F = {ratio} μP reaches or exceeds the friction limit μP: the sphere slides as a whole (gross sliding); use a ratio below 1"
+                ),
+            ));
+        }
+        if ratio > 0.0 && load.friction == 0.0 {
+            return Err(SolverError::invalid(
+                "load.friction",
+                "a tangential force needs a positive friction coefficient",
+            ));
+        }
+        if !load.angle_deg.is_finite() {
+            return Err(SolverError::invalid(
+                "load.angle_deg",
+                "the force angle must be finite",
+            ));
+        }
+        let num = &self.numerics;
+        positive("numerics.tolerance", num.tolerance, "the tolerance")?;
+        positive(
+            "numerics.tangential_tolerance",
+            num.tangential_tolerance,
+            "the tangential tolerance",
+        )?;
+        positive(
+            "numerics.coupling_tolerance",
+            num.coupling_tolerance,
+            "the coupling tolerance",
+        )?;
+        if num.max_iterations == 0 {
+            return Err(SolverError::invalid(
+                "numerics.max_iterations",
+                "must be at least 1",
+            ));
+        }
+        if num.max_coupling_iterations == 0 {
+            return Err(SolverError::invalid(
+                "numerics.max_coupling_iterations",
+                "must be at least 1",
+            ));
+        }
+        self.material
+            .validate()
+            .map_err(|e| within("material", e))?;
+        if let Some(ball) = &self.indenter {
+            ball.validate().map_err(|e| within("indenter", e))?;
+        }
+        self.surface
+            .validate(grid.n)
+            .map_err(|e| within("surface", e))?;
+        // A contact a few cells across cannot be solved meaningfully (a
+        // 1e-300 m sphere gave δz = 4.6e296 m, #20 item 8). Hertz's radius
+        // with the isotropic-equivalent constants is the scale; patterns
+        // and anisotropy change it by tens of per cent, not by cells.
+        // Under a load history the smallest normal load sets the smallest contact.
+        let mut normal_min = load.normal_force_n;
+        if let Some(h) = &self.history {
+            if let Some(v) = &h.normal_forces_n {
+                normal_min = v.iter().cloned().fold(f64::INFINITY, f64::min);
+            }
+            if h.tangential_ratios.iter().any(|&r| r != 0.0) && load.friction == 0.0 {
+                return Err(SolverError::invalid(
+                    "load.friction",
+                    "a tangential force needs a positive friction coefficient",
+                ));
+            }
+        }
+        let a_hertz =
+            (3.0 * normal_min * load.indenter_radius_m / (4.0 * self.contact_modulus())).cbrt();
+        let min = MIN_RESOLVED_CELLS * grid.dx;
+        if a_hertz < min {
+            return Err(SolverError::ContactUnresolved {
+                detail: format!(
+                    "the Hertz contact radius {a_hertz:.3e} m spans fewer than {} cells of {:.3e} m",
+                    MIN_RESOLVED_CELLS,
+                    grid.dx
+                ),
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,424 @@
+//! The results of one case: its scalars and fields, the definitions behind
+//! them (apparent radii, K_E), μa (paper Eq. 19) and its K_E calibration on
+//! the flat surface, and the reduction of a solved contact state to them.
+//! Solves nothing.
+
+use serde::{Deserialize, Serialize};
+
+use crate::base::geometry::{covered_area, equivalent_radius, hull_area};
+use crate::error::SolverError;
+use crate::model::radii::{apparent_radius, friction_reserve};
+use crate::model::spec::{CaseSpec, Load, MIN_RESOLVED_CELLS};
+use crate::model::surface::Terrain;
+use crate::operators::operator::{Operator, X, Y, Z};
+use crate::solve::coupling::ContactState;
+use crate::solve::history::HistoryOutput;
+use crate::solve::normal::NormalReport;
+use crate::solve::tangential::{TangentialReport, TangentialSolution};
+
+/// The scalars of one solved case.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CaseScalars {
+    /// Apparent contact radius a: circle with the area of the convex hull of
+    /// the contact boundary located between cell centres
+    /// ([`crate::APPARENT_RADIUS_DEFINITION`]), m. Used for μa and K_E.
+    pub contact_radius_m: f64,
+    /// Apparent stick radius c: same for the stick zone, m.
+    pub stick_radius_m: f64,
+    /// The paper's a: circle with the area of the convex hull of the contact
+    /// cells, each taken as its full square ([`crate::APPARENT_RADIUS_DEFINITION_CELLS`]), m.
+    #[serde(default)]
+    pub contact_radius_cells_m: f64,
+    /// The paper's c: same for the stick cells, m.
+    #[serde(default)]
+    pub stick_radius_cells_m: f64,
+    /// Rigid tangential shift δt projected on the force direction, m.
+    pub delta_t_m: f64,
+    /// Component of δt perpendicular to the force (left of it), m.
+    pub delta_t_perp_m: f64,
+    /// Rigid-body approach δz, m.
+    pub delta_z_m: f64,
+    /// Peak pressure, Pa.
+    pub p_max_pa: f64,
+    /// Peak shear traction magnitude, Pa.
+    pub q_max_pa: f64,
+    /// Contact area (cells with p > 0), m².
+    pub contact_area_m2: f64,
+    /// Stick area, m².
+    pub stick_area_m2: f64,
+    /// True when any contact cell lies off the island tops (patterned surfaces).
+    pub base_contact: bool,
+    /// Apparent friction coefficient from Eq. 19 with a and c (None without tangential load).
+    pub mu_a: Option<f64>,
+    /// K_E used for μa, Pa.
+    pub k_e: f64,
+    /// μa from Eq. 19 with the paper's radii (`*_cells_m`) and `k_e_cells`.
+    #[serde(default)]
+    pub mu_a_cells: Option<f64>,
+    /// K_E used for `mu_a_cells` (differs from `k_e` only when calibrated on
+    /// the flat surface, with the paper's radii), Pa.
+    #[serde(default)]
+    pub k_e_cells: f64,
+    /// Where K_E came from: "isotropic" (formula with E, ν) or "flat-calibrated".
+    pub k_e_source: String,
+    /// Hertz contact radius with the isotropic-equivalent constants, m.
+    pub hertz_radius_m: f64,
+    /// Hertz peak pressure with the isotropic-equivalent constants, Pa.
+    pub hertz_pressure_pa: f64,
+    /// Total normal force recovered from the pressure, N.
+    pub normal_force_n: f64,
+    /// Total tangential force recovered from the tractions (x, y), N.
+    pub tangential_force_n: [f64; 2],
+    /// All loops converged.
+    pub converged: bool,
+    /// Normal CG iterations, summed over coupling iterations, with those
+    /// of the contact from rest even when the worker reused it from an
+    /// earlier case ([`crate::solve::normal::solve_normal_from_rest`]): the same
+    /// count whichever worker ran the case.
+    pub normal_iterations: usize,
+    /// Tangential iterations, summed over coupling iterations.
+    pub tangential_iterations: usize,
+    /// Coupling iterations (1 when uncoupled).
+    pub coupling_iterations: usize,
+    /// Final relative change of p between the last two coupling iterations.
+    pub coupling_change: f64,
+    /// Report of the last normal solve.
+    pub normal: NormalReport,
+    /// Report of the last tangential solve.
+    pub tangential: TangentialReport,
+    /// Wall time of the solve (operator build excluded), s.
+    pub seconds: f64,
+    /// Wall time spent building or loading the operator for this case
+    /// (0 when it was already resident), s.
+    #[serde(default)]
+    pub kernel_seconds: f64,
+    /// The load path's table and reductions, for a case with a history
+    /// (the other scalars then describe the path's final state).
+    #[serde(default)]
+    pub history: Option<HistoryOutput>,
+}
+
+/// Surface fields of a solved case, each `n x n`, row-major `[iy][ix]` (y rows, x columns).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Fields {
+    /// Cells per side.
+    pub n: usize,
+    /// Pressure, Pa.
+    pub p: Vec<f64>,
+    /// Shear traction x, Pa.
+    pub qx: Vec<f64>,
+    /// Shear traction y, Pa.
+    pub qy: Vec<f64>,
+    /// Slip x, m.
+    pub sx: Vec<f64>,
+    /// Slip y, m.
+    pub sy: Vec<f64>,
+    /// 1 on stick cells, 0 elsewhere.
+    pub stick: Vec<f64>,
+    /// Surface displacement x, m.
+    pub ux: Vec<f64>,
+    /// Surface displacement y, m.
+    pub uy: Vec<f64>,
+    /// Surface displacement z (into the body), m.
+    pub uz: Vec<f64>,
+}
+
+impl Fields {
+    /// The fields with their file names, in a fixed order.
+    pub fn named(&self) -> [(&'static str, &Vec<f64>); 9] {
+        [
+            ("p", &self.p),
+            ("qx", &self.qx),
+            ("qy", &self.qy),
+            ("sx", &self.sx),
+            ("sy", &self.sy),
+            ("stick", &self.stick),
+            ("ux", &self.ux),
+            ("uy", &self.uy),
+            ("uz", &self.uz),
+        ]
+    }
+}
+
+/// Scalars and fields of one case.
+#[derive(Clone, Debug)]
+pub struct CaseOutput {
+    /// Scalars.
+    pub scalars: CaseScalars,
+    /// Fields.
+    pub fields: Fields,
+    /// With a load history: the tractions at its turning points (empty
+    /// without one).
+    pub turning: Vec<crate::solve::history::TurningState>,
+}
+
+/// How K_E in μa is obtained.
+pub const K_E_DEFINITION: &str = "isotropic: K_E = 8E/(3(1+nu)(2-nu)) (paper Eq. 19); anisotropic: K_E(psi) = mu P (a^2 - c^2)/(delta_F a^3) calibrated on the flat surface of the same material at the same force angle";
+
+/// `k_e_source` of a K_E from Mindlin's isotropic formula.
+pub const K_E_ISOTROPIC: &str = "isotropic";
+/// `k_e_source` of a K_E calibrated on the flat surface.
+pub const K_E_FLAT_CALIBRATED: &str = "flat-calibrated";
+
+/// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)), with the radii `[a, c]`.
+fn eq19(delta_t: f64, [a, c]: [f64; 2], normal_force_n: f64, k_e: f64) -> f64 {
+    delta_t * a.powi(3) * k_e / (normal_force_n * (a * a - c * c))
+}
+
+/// Eq. 19 solved for K_E so that it returns `friction`.
+fn eq19_k_e(delta_t: f64, [a, c]: [f64; 2], normal_force_n: f64, friction: f64) -> f64 {
+    friction * normal_force_n * (a * a - c * c) / (delta_t * a.powi(3))
+}
+
+impl CaseScalars {
+    /// a and c ([`crate::APPARENT_RADIUS_DEFINITION`]).
+    pub fn radii(&self) -> [f64; 2] {
+        [self.contact_radius_m, self.stick_radius_m]
+    }
+
+    /// The paper's a and c ([`crate::APPARENT_RADIUS_DEFINITION_CELLS`]).
+    pub fn radii_cells(&self) -> [f64; 2] {
+        [self.contact_radius_cells_m, self.stick_radius_cells_m]
+    }
+}
+
+/// Paper Eq. 19: μa = δF a³ K_E / (P (a² − c²)), with a and c.
+pub fn mu_apparent(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> f64 {
+    eq19(s.delta_t_m, s.radii(), normal_force_n, k_e)
+}
+
+/// K_E calibrated from a flat-surface case so that Eq. 19 (with a and c)
+/// returns μ there.
+pub fn calibrate_k_e(flat: &CaseScalars, friction: f64, normal_force_n: f64) -> f64 {
+    eq19_k_e(flat.delta_t_m, flat.radii(), normal_force_n, friction)
+}
+
+/// μa from Eq. 19 with the paper's radii, when they leave a slip annulus.
+fn mu_apparent_cells(s: &CaseScalars, normal_force_n: f64, k_e: f64) -> Option<f64> {
+    let [a, c] = s.radii_cells();
+    (c < a).then(|| eq19(s.delta_t_m, [a, c], normal_force_n, k_e))
+}
+
+/// The μa of a case of an anisotropic material: K_E(ψ) calibrated on the
+/// scalars `flat` of its flat twin (the same material, grid, load and angle
+/// on the flat surface; `s` itself for a flat case), and μa (Eq. 19) with
+/// it. Sets `k_e`, `k_e_source` and `mu_a` of `s`. The one place both a
+/// single solve and a sweep calibrate (see [`crate::CaseSpec::needs_flat_calibration`]).
+pub fn calibrate_on_flat(s: &mut CaseScalars, flat: &CaseScalars, load: &Load) {
+    let k_e = calibrate_k_e(flat, load.friction, load.normal_force_n);
+    s.k_e = k_e;
+    s.k_e_source = K_E_FLAT_CALIBRATED.into();
+    s.mu_a = Some(mu_apparent(s, load.normal_force_n, k_e));
+    // Each definition is calibrated with its own radii, so that both return
+    // μ on the flat surface.
+    s.k_e_cells = eq19_k_e(
+        flat.delta_t_m,
+        flat.radii_cells(),
+        load.normal_force_n,
+        load.friction,
+    );
+    s.mu_a_cells = mu_apparent_cells(s, load.normal_force_n, s.k_e_cells);
+}
+
+/// The fields and scalars of a solved case: total displacements from all
+/// tractions, radii, shifts, forces and μa with the isotropic-equivalent K_E.
+/// `started` is when the solve began (for `seconds`). With a load path's
+/// `history`, a final state without a resolved slip annulus (everything
+/// sticks, as under proportional loading) is a result, with μa `None`; so is
+/// the state of an unconverged solve (flagged by `converged`), whose radii
+/// are not checked against the grid.
+pub(crate) fn reduce(
+    spec: &CaseSpec,
+    terrain: &Terrain,
+    op: &mut Operator,
+    state: ContactState,
+    started: std::time::Instant,
+    kernel_seconds: f64,
+    history: Option<HistoryOutput>,
+) -> Result<CaseOutput, SolverError> {
+    let is_history = history.is_some();
+    let ContactState {
+        p,
+        approach,
+        tangential,
+        normal_report,
+        normal_iterations,
+        tangential_iterations,
+        coupling_iterations,
+        coupling_change,
+        coupling_converged,
+    } = state;
+    let grid = spec.grid;
+    let (n, len, da) = (grid.n, grid.len(), grid.cell_area());
+    let load = spec.load.normal_force_n;
+    let force = spec.load.tangential_force();
+    let fnorm = force[0].hypot(force[1]);
+    let TangentialSolution {
+        qx,
+        qy,
+        sx,
+        sy,
+        stick,
+        shift,
+        report: tan_report,
+    } = tangential;
+    // Total displacements from all tractions.
+    let (mut ux, mut uy, mut uz) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+    op.apply(
+        &[(X, &qx), (Y, &qy), (Z, &p)],
+        &mut [(X, &mut ux), (Y, &mut uy), (Z, &mut uz)],
+    );
+
+    let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
+    let stick_in_contact: Vec<bool> = (0..len).map(|i| contact[i] && stick[i]).collect();
+    // A cut cell contributes its covered part.
+    let cover = terrain.cover.as_deref();
+    let contact_area = covered_area(&contact, cover, da);
+    let stick_area = covered_area(&stick_in_contact, cover, da);
+    // The paper's radii (whole cells) decide what the grid resolves, as
+    // before the sub-cell radii existed; the two differ by less than a cell.
+    let a = equivalent_radius(hull_area(&grid, &contact));
+    // A history's state has a stick set at any force (at F = 0 the tractions
+    // of Spence's normal loading with friction, or those locked in after
+    // unloading); a monotonic case without force has none.
+    let has_stick_set = fnorm > 0.0 || is_history;
+    let c = if has_stick_set {
+        equivalent_radius(hull_area(&grid, &stick_in_contact))
+    } else {
+        a
+    };
+    // A zone a few cells across has no radius worth reporting: μa from
+    // it is grid noise (a stick zone of a few cells gave μa = 434, #20 item 8).
+    let min_radius = MIN_RESOLVED_CELLS * grid.dx.max(grid.dy);
+    // An unconverged solve is flagged as such: its radii are those of an
+    // intermediate iterate, and calling it unresolved would send the user to
+    // refine a grid that was not the problem.
+    let converged = normal_report.converged && tan_report.converged && coupling_converged;
+    if converged && a < min_radius {
+        return Err(SolverError::ContactUnresolved {
+            detail: format!(
+                "a = {a:.3e} m spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m",
+                grid.dx
+            ),
+        });
+    }
+    if converged && fnorm > 0.0 && c < min_radius && !is_history {
+        return Err(SolverError::SlipUnresolved {
+            detail: format!(
+                "the stick zone, c = {c:.3e} m, spans fewer than {MIN_RESOLVED_CELLS} cells of {:.3e} m (F/μP = {} leaves almost no stick)",
+                grid.dx, spec.load.tangential_ratio
+            ),
+        });
+    }
+    let dir = if fnorm > 0.0 {
+        [force[0] / fnorm, force[1] / fnorm]
+    } else {
+        [1.0, 0.0]
+    };
+    let heights = &terrain.heights;
+    let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let base_contact = !matches!(spec.surface, crate::model::surface::Surface::Flat)
+        && (0..len).any(|i| contact[i] && heights[i] < top);
+    let hertz_radius =
+        (3.0 * load * spec.load.indenter_radius_m / (4.0 * spec.contact_modulus())).cbrt();
+    // The radii of μa (`solver.radii`): by default the sub-cell hulls (p
+    // falls to zero like the root of the distance at a Hertzian edge, and
+    // μp − |q| does at a Mindlin stick edge), or the second moments of the
+    // same two levels.
+    let friction = spec.load.friction;
+    let radii = spec.numerics.radii;
+    let a_app = apparent_radius(radii, &grid, &contact, &p, terrain);
+    let c_app = if has_stick_set {
+        let reserve = friction_reserve(friction, &p, (&qx, &qy));
+        apparent_radius(radii, &grid, &stick_in_contact, &reserve, terrain)
+    } else {
+        a_app
+    };
+    let mut s = CaseScalars {
+        contact_radius_m: a_app,
+        stick_radius_m: c_app,
+        contact_radius_cells_m: a,
+        stick_radius_cells_m: c,
+        delta_t_m: shift[0] * dir[0] + shift[1] * dir[1],
+        delta_t_perp_m: -shift[0] * dir[1] + shift[1] * dir[0],
+        delta_z_m: approach,
+        p_max_pa: p.iter().cloned().fold(0.0, f64::max),
+        q_max_pa: (0..len).map(|i| qx[i].hypot(qy[i])).fold(0.0, f64::max),
+        contact_area_m2: contact_area,
+        stick_area_m2: stick_area,
+        base_contact,
+        mu_a: None,
+        k_e: spec.mindlin_k_e(),
+        mu_a_cells: None,
+        k_e_cells: spec.mindlin_k_e(),
+        k_e_source: K_E_ISOTROPIC.into(),
+        hertz_radius_m: hertz_radius,
+        hertz_pressure_pa: 3.0 * load / (2.0 * std::f64::consts::PI * hertz_radius * hertz_radius),
+        normal_force_n: p.iter().sum::<f64>() * da,
+        tangential_force_n: [qx.iter().sum::<f64>() * da, qy.iter().sum::<f64>() * da],
+        converged,
+        normal_iterations,
+        tangential_iterations,
+        coupling_iterations: coupling_iterations.max(1),
+        coupling_change,
+        normal: normal_report,
+        tangential: tan_report,
+        seconds: started.elapsed().as_secs_f64(),
+        kernel_seconds,
+        history,
+    };
+    let annulus = c < a && c_app < a_app && c >= min_radius;
+    if fnorm > 0.0 && (is_history || !converged) {
+        if annulus {
+            s.mu_a = Some(mu_apparent(&s, load, s.k_e));
+            s.mu_a_cells = mu_apparent_cells(&s, load, s.k_e_cells);
+        }
+    } else if fnorm > 0.0 {
+        if c >= a {
+            let slipping = contact_area - stick_area;
+            return Err(SolverError::SlipUnresolved {
+                detail: if slipping > 0.0 {
+                    format!(
+                        "the {} slipping cells lie inside the stick zone's outline, so a = c = {a:.4e} m",
+                        (slipping / da).round()
+                    )
+                } else {
+                    format!(
+                        "all {} contact cells stick under F = {:.4e} N, so a = c = {a:.4e} m",
+                        (contact_area / da).round(),
+                        fnorm
+                    )
+                },
+            });
+        }
+        if c_app >= a_app {
+            return Err(SolverError::SlipUnresolved {
+                detail: format!(
+                    "the stick zone's boundary reaches the contact boundary, c = a = {a_app:.4e} m"
+                ),
+            });
+        }
+        s.mu_a = Some(mu_apparent(&s, load, s.k_e));
+        s.mu_a_cells = mu_apparent_cells(&s, load, s.k_e_cells);
+    }
+    let fields = Fields {
+        n,
+        stick: stick_in_contact
+            .iter()
+            .map(|&b| if b { 1.0 } else { 0.0 })
+            .collect(),
+        p,
+        qx,
+        qy,
+        sx,
+        sy,
+        ux,
+        uy,
+        uz,
+    };
+    Ok(CaseOutput {
+        scalars: s,
+        fields,
+        turning: Vec::new(),
+    })
+}

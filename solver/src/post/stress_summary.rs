@@ -1,0 +1,606 @@
+//! The stresses of one solved case and the scalars read from them: which
+//! states (the turning points of a load history, or the case's one
+//! state), where (horizontal planes at chosen depths, two vertical slices
+//! through the contact centre, the surface plane for the fatigue
+//! parameter), and the maxima, Crossland's and Smith–Watson–Topper's
+//! parameters. Shared by `mpcontact solve`, the Python module and the
+//! sweep's workers, so the three give the same numbers to the bit. The
+//! stresses themselves are [`crate::operators::stress`].
+//!
+//! ```
+//! use solver::stress_summary::swt_point;
+//! // Uniaxial σxx = ±σa on an isotropic surface: SWT = σa²/E on the plane
+//! // whose normal is x.
+//! let (e, nu, sa) = (200e9, 0.3, 100e6);
+//! let c = solver::Isotropic::new(e, nu).unwrap().stiffness();
+//! let s = c.try_inverse().unwrap();
+//! let at = swt_point(&[[sa, 0.0, 0.0, 0.0, 0.0, 0.0], [-sa, 0.0, 0.0, 0.0, 0.0, 0.0]], &s);
+//! assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12);
+//! assert_eq!(at.angle_deg, 0.0);
+//! ```
+
+use nalgebra::Matrix6;
+use serde::{Deserialize, Serialize};
+
+use crate::operators::stress::{max_principal, tresca, von_mises, Line, StressField, StressPlan};
+use crate::{CaseScalars, CaseSpec, Fields, SolverError, TurningState};
+
+/// How the Crossland parameter is formed from the states computed.
+pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the extremes of a fretting cycle; with more, the smallest enclosing sphere's radius exceeds it by at most 2/sqrt(3) for three states and sqrt(5/3) for more), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
+
+/// Where the maxima are sought.
+pub const MAXIMA_DEFINITION: &str = "maxima over the points computed: every plane of stress.depths_um and the two slices (the grid row and column through the cell nearest the pressure centroid; 'along' is the one nearer the force direction); the surface peak is the stress along the force direction, sigma_tt = sxx c^2 + syy s^2 + 2 sxy s c, on the top row of the 'along' slice";
+
+/// How the Smith–Watson–Topper parameter is formed.
+pub const SWT_DEFINITION: &str = "Smith-Watson-Topper at the surface (z = 0, every cell of the grid): SWT = sigma_n,max * eps_a on the planes normal to the surface, their normal n = (cos t, sin t, 0) for t = 0, 1, ..., 179 degrees; sigma_n = n.sigma.n of each state, eps_n = n.eps.n with eps = C^-1 sigma (the substrate's compliance); over the states computed (a load history's turning points) sigma_n,max is the largest sigma_n and eps_a half the range of eps_n; a single state is taken as a cycle from the unloaded surface to that state and back (sigma_n,max = max(sigma_n, 0), eps_a = |eps_n| / 2); SWT = 0 where sigma_n,max <= 0; the critical plane is the t of the largest SWT";
+
+/// Directions of the critical-plane search (one per degree over a half turn).
+pub const SWT_DIRECTIONS: usize = 180;
+
+/// What to compute (the solver's form of `[stress]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StressRequest {
+    /// Depths of the horizontal planes, m.
+    pub depths_m: Vec<f64>,
+    /// The two vertical slices through the contact centre.
+    pub slices: bool,
+    /// Deepest row of the slices, m (`None`: twice the contact radius).
+    pub slice_depth_m: Option<f64>,
+    /// Rows of a slice (≥ 2), the surface included.
+    pub slice_rows: usize,
+    /// With a load history: every turning point (`true`) or the final
+    /// increment only.
+    pub turning_states: bool,
+    /// Crossland's coefficient α.
+    pub crossland_alpha: f64,
+}
+
+/// A value and its place (m; z into the body).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Located {
+    /// The value, Pa.
+    pub value_pa: f64,
+    /// The value over the Hertz pressure p_H.
+    pub over_p_h: f64,
+    /// x, y, z of the point, m.
+    pub at_m: [f64; 3],
+}
+
+/// The scalars of one state.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct StateScalars {
+    /// Increment of the load history (None: the case's only state).
+    pub step: Option<usize>,
+    /// Largest von Mises stress.
+    pub max_von_mises: Located,
+    /// Largest Tresca (maximum shear) stress.
+    pub max_tresca: Located,
+    /// Largest principal stress.
+    pub max_principal: Located,
+    /// Peak surface stress along the force direction (with slices).
+    // (no skip_serializing_if: the scalars also travel in bincode, which needs every field)
+    #[serde(default)]
+    pub surface_peak_along_force: Option<Located>,
+}
+
+/// The Smith–Watson–Topper parameter's largest value over the surface.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SwtScalars {
+    /// SWT = σn,max εa, Pa (strain dimensionless).
+    pub value_pa: f64,
+    /// The surface point (z = 0), m.
+    pub at_m: [f64; 3],
+    /// Angle of the critical plane's normal from x, degrees in [0, 180).
+    pub plane_angle_deg: f64,
+    /// σn,max on that plane, Pa.
+    pub sigma_max_pa: f64,
+    /// εa on that plane.
+    pub strain_amplitude: f64,
+}
+
+/// The scalars of a case's stresses (`case.json`'s `stress`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct StressScalars {
+    /// One entry per state computed.
+    pub states: Vec<StateScalars>,
+    /// Crossland's parameter over the states (two or more).
+    // (no skip_serializing_if: the scalars also travel in bincode, which needs every field)
+    #[serde(default)]
+    pub crossland: Option<Located>,
+    /// Crossland's α.
+    pub crossland_alpha: f64,
+    /// See [`CROSSLAND_DEFINITION`].
+    pub crossland_definition: String,
+    /// See [`MAXIMA_DEFINITION`].
+    pub maxima_definition: String,
+    /// Smith–Watson–Topper at the surface.
+    pub swt: SwtScalars,
+    /// See [`SWT_DEFINITION`].
+    pub swt_definition: String,
+    /// Depths of the slices' rows, m.
+    pub slice_depths_m: Vec<f64>,
+    /// The slice along the force: `x` (a grid row) or `y` (a column).
+    pub slice_along: String,
+    /// The cell centre the slices pass through (x, y), m.
+    pub slice_through_m: [f64; 2],
+}
+
+impl StressScalars {
+    /// Largest value of `f` over the states (the worst state of a cycle).
+    pub fn worst(&self, f: impl Fn(&StateScalars) -> Option<Located>) -> Option<Located> {
+        self.states
+            .iter()
+            .filter_map(f)
+            .fold(None, |b: Option<Located>, l| match b {
+                Some(b) if b.value_pa >= l.value_pa => Some(b),
+                _ => Some(l),
+            })
+    }
+}
+
+/// One state's stresses on the planes and slices.
+pub struct StateStress {
+    /// Increment (None: the case's only state).
+    pub step: Option<usize>,
+    /// Pressure of the state (for the contact edge in the maps), Pa.
+    pub p: Vec<f64>,
+    /// One field per depth of the request.
+    pub planes: Vec<StressField>,
+    /// The slice along the force: one line per slice depth.
+    pub along: Vec<StressField>,
+    /// The slice across the force.
+    pub across: Vec<StressField>,
+}
+
+/// The stresses of a case: its states, the derived fields and the scalars.
+pub struct CaseStress {
+    /// The states.
+    pub states: Vec<StateStress>,
+    /// The scalars.
+    pub scalars: StressScalars,
+    /// Crossland's parameter on each plane (with two states or more).
+    pub crossland_planes: Vec<Vec<f64>>,
+    /// Crossland's parameter on the slices (rows = depths).
+    pub crossland_slices: Option<[Vec<f64>; 2]>,
+    /// SWT over the surface (n x n, rows y), Pa.
+    pub swt_surface: Vec<f64>,
+    /// Grid row and column of the slices.
+    pub centre: (usize, usize),
+    /// The slice along the force is a grid row.
+    pub along_is_row: bool,
+    /// Depths of the planes, m.
+    pub depths_m: Vec<f64>,
+    /// The grid.
+    pub grid: crate::Grid,
+    /// Contact radius the maps are scaled with, m.
+    pub contact_radius_m: f64,
+    /// Hertz pressure, Pa.
+    pub p_h: f64,
+}
+
+/// A state's increment (None: the case's only state) and its `p, qx, qy`.
+type StateTractions<'a> = (Option<usize>, &'a [f64], &'a [f64], &'a [f64]);
+
+/// Cell nearest the pressure centroid.
+fn centroid(grid: &crate::Grid, p: &[f64]) -> (usize, usize) {
+    let n = grid.n;
+    let (mut w, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    for iy in 0..n {
+        for ix in 0..n {
+            let v = p[iy * n + ix];
+            w += v;
+            sx += v * ix as f64;
+            sy += v * iy as f64;
+        }
+    }
+    if w <= 0.0 {
+        return (n / 2, n / 2);
+    }
+    let r = |v: f64| (v / w).round().clamp(0.0, (n - 1) as f64) as usize;
+    (r(sx), r(sy))
+}
+
+/// SWT at one surface point over its states: the critical plane's value,
+/// angle, σn,max and εa (see [`SWT_DEFINITION`]). `compliance` is `C⁻¹`
+/// in Voigt order xx, yy, zz, yz, xz, xy with engineering shear strains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwtPoint {
+    /// SWT, Pa.
+    pub value: f64,
+    /// Normal of the critical plane from x, degrees.
+    pub angle_deg: f64,
+    /// σn,max, Pa.
+    pub sigma_max: f64,
+    /// εa.
+    pub strain_amplitude: f64,
+}
+
+/// SWT of the states `states` at one point (see [`SWT_DEFINITION`]).
+pub fn swt_point(states: &[[f64; 6]], compliance: &Matrix6<f64>) -> SwtPoint {
+    let strains: Vec<[f64; 6]> = states
+        .iter()
+        .map(|s| {
+            let v = compliance * nalgebra::Vector6::from_column_slice(s);
+            [v[0], v[1], v[2], v[3], v[4], v[5]]
+        })
+        .collect();
+    swt_of_strains(states, &strains)
+}
+
+fn swt_of_strains(states: &[[f64; 6]], strains: &[[f64; 6]]) -> SwtPoint {
+    let mut best = SwtPoint {
+        value: 0.0,
+        angle_deg: 0.0,
+        sigma_max: 0.0,
+        strain_amplitude: 0.0,
+    };
+    let single = states.len() == 1;
+    for k in 0..SWT_DIRECTIONS {
+        let deg = k as f64 * 180.0 / SWT_DIRECTIONS as f64;
+        let (s, c) = deg.to_radians().sin_cos();
+        let (cc, ss, sc) = (c * c, s * s, s * c);
+        let (mut smax, mut emax, mut emin) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::INFINITY);
+        for (t, e) in states.iter().zip(strains) {
+            smax = smax.max(t[0] * cc + t[1] * ss + 2.0 * t[5] * sc);
+            // engineering shear strain: ε_n = εxx c² + εyy s² + γxy s c
+            let en = e[0] * cc + e[1] * ss + e[5] * sc;
+            emax = emax.max(en);
+            emin = emin.min(en);
+        }
+        let (sigma_max, amp) = if single {
+            (smax.max(0.0), 0.5 * emax.abs())
+        } else {
+            (smax, 0.5 * (emax - emin))
+        };
+        let value = if sigma_max > 0.0 {
+            sigma_max * amp
+        } else {
+            0.0
+        };
+        if value > best.value {
+            best = SwtPoint {
+                value,
+                angle_deg: deg,
+                sigma_max,
+                strain_amplitude: amp,
+            };
+        }
+    }
+    best
+}
+
+/// Crossland's parameter of a point's states (see [`CROSSLAND_DEFINITION`]).
+fn crossland_at(ts: &[[f64; 6]], alpha: f64) -> f64 {
+    let dev = |t: &[f64; 6]| {
+        let m = (t[0] + t[1] + t[2]) / 3.0;
+        [t[0] - m, t[1] - m, t[2] - m, t[3], t[4], t[5]]
+    };
+    let mut amp: f64 = 0.0;
+    for i in 0..ts.len() {
+        for j in i + 1..ts.len() {
+            let (a, b) = (dev(&ts[i]), dev(&ts[j]));
+            let d: [f64; 6] = std::array::from_fn(|k| 0.5 * (a[k] - b[k]));
+            let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                + d[3] * d[3]
+                + d[4] * d[4]
+                + d[5] * d[5];
+            amp = amp.max(j2.sqrt());
+        }
+    }
+    let sh = ts
+        .iter()
+        .map(|t| (t[0] + t[1] + t[2]) / 3.0)
+        .fold(f64::NEG_INFINITY, f64::max);
+    amp + alpha * sh
+}
+
+/// Computes the stresses `req` asks for on the states of a solved case:
+/// the turning points of its load history (or its final state), else the
+/// case's one state; and the scalars.
+pub fn compute(
+    req: &StressRequest,
+    spec: &CaseSpec,
+    scalars: &CaseScalars,
+    fields: &Fields,
+    turning: &[TurningState],
+) -> Result<CaseStress, SolverError> {
+    let grid = spec.grid;
+    let n = grid.n;
+    let states: Vec<StateTractions> = if req.turning_states && !turning.is_empty() {
+        turning
+            .iter()
+            .map(|t| (Some(t.step), &t.p[..], &t.qx[..], &t.qy[..]))
+            .collect()
+    } else {
+        vec![(None, &fields.p[..], &fields.qx[..], &fields.qy[..])]
+    };
+    let mut plan = StressPlan::new(&spec.material, grid)?;
+    let tractions: Vec<_> = states
+        .iter()
+        .map(|(_, p, qx, qy)| plan.tractions(p, qx, qy))
+        .collect();
+    let (ix0, iy0) = centroid(&grid, &fields.p);
+    let psi = spec.load.angle_deg.to_radians();
+    let along_is_row = psi.cos().abs() >= psi.sin().abs();
+    let (along, across) = if along_is_row {
+        (Line::Row(iy0), Line::Column(ix0))
+    } else {
+        (Line::Column(ix0), Line::Row(iy0))
+    };
+    let a = if scalars.contact_radius_m > 0.0 {
+        scalars.contact_radius_m
+    } else {
+        scalars.hertz_radius_m
+    };
+    let slice_depths: Vec<f64> = if req.slices {
+        let deepest = req.slice_depth_m.unwrap_or(2.0 * a);
+        (0..req.slice_rows)
+            .map(|k| deepest * k as f64 / (req.slice_rows - 1) as f64)
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mut out: Vec<StateStress> = states
+        .iter()
+        .map(|(step, p, _, _)| StateStress {
+            step: *step,
+            p: p.to_vec(),
+            planes: Vec::new(),
+            along: Vec::new(),
+            across: Vec::new(),
+        })
+        .collect();
+    // One kernel per depth, applied to every state.
+    for &z in &slice_depths {
+        let plane = plan.plane(z)?;
+        for (s, t) in out.iter_mut().zip(&tractions) {
+            s.along.push(plan.apply_line(&plane, t, along));
+            s.across.push(plan.apply_line(&plane, t, across));
+        }
+    }
+    let depths_m = req.depths_m.clone();
+    let mut surface: Option<Vec<StressField>> = None;
+    for &z in &depths_m {
+        let plane = plan.plane(z)?;
+        for (s, t) in out.iter_mut().zip(&tractions) {
+            s.planes.push(plan.apply(&plane, t));
+        }
+    }
+    // The surface plane for SWT: a plane of the request at z = 0, else its own.
+    let on_surface = depths_m.iter().position(|&z| z == 0.0);
+    if on_surface.is_none() {
+        let plane = plan.plane(0.0)?;
+        surface = Some(tractions.iter().map(|t| plan.apply(&plane, t)).collect());
+    }
+    let surface_of = |k: usize| -> &StressField {
+        match (&surface, on_surface) {
+            (Some(s), _) => &s[k],
+            (None, Some(j)) => &out[k].planes[j],
+            (None, None) => unreachable!("a surface plane is computed above"),
+        }
+    };
+    let p_h = scalars.hertz_pressure_pa;
+    let at_line = |line: Line, i: usize, z: f64| match line {
+        Line::Row(iy) => [grid.x(i), grid.y(iy), z],
+        Line::Column(ix) => [grid.x(ix), grid.y(i), z],
+    };
+    let located = |v: f64, at: [f64; 3]| Located {
+        value_pa: v,
+        over_p_h: v / p_h,
+        at_m: at,
+    };
+    // Every point computed of a state: (tensor, place).
+    let points = |s: &StateStress| -> Vec<([f64; 6], [f64; 3])> {
+        let mut pts = Vec::new();
+        for (line, rows) in [(along, &s.along), (across, &s.across)] {
+            for f in rows.iter() {
+                for i in 0..f.len() {
+                    pts.push((f.at(i), at_line(line, i, f.depth_m)));
+                }
+            }
+        }
+        for f in &s.planes {
+            for i in 0..f.len() {
+                pts.push((f.at(i), [grid.x(i % n), grid.y(i / n), f.depth_m]));
+            }
+        }
+        pts
+    };
+    let best = |pts: &[([f64; 6], [f64; 3])], f: &dyn Fn([f64; 6]) -> f64| {
+        let mut b = (f64::NEG_INFINITY, [0.0; 3]);
+        for (s, at) in pts {
+            let v = f(*s);
+            if v > b.0 {
+                b = (v, *at);
+            }
+        }
+        located(b.0, b.1)
+    };
+    let (c, s) = (psi.cos(), psi.sin());
+    let along_force = |t: [f64; 6]| t[0] * c * c + t[1] * s * s + 2.0 * t[5] * s * c;
+    let mut state_scalars = Vec::new();
+    for st in &out {
+        let pts = points(st);
+        let surface_peak = st.along.first().map(|top| {
+            let vals = top.map(along_force);
+            let pk = crate::operators::stress::peak(&vals).expect("a line has points");
+            located(pk.value, at_line(along, pk.index, 0.0))
+        });
+        state_scalars.push(StateScalars {
+            step: st.step,
+            max_von_mises: best(&pts, &von_mises),
+            max_tresca: best(&pts, &tresca),
+            max_principal: best(&pts, &max_principal),
+            surface_peak_along_force: surface_peak,
+        });
+    }
+    // SWT over the surface.
+    let compliance =
+        spec.material
+            .stiffness()
+            .try_inverse()
+            .ok_or_else(|| SolverError::Invalid {
+                field: "material".into(),
+                reason: "the stiffness matrix is singular (no compliance for SWT)".into(),
+            })?;
+    let mut swt_surface = vec![0.0; n * n];
+    let mut swt = SwtScalars {
+        value_pa: 0.0,
+        at_m: [grid.x(ix0), grid.y(iy0), 0.0],
+        plane_angle_deg: 0.0,
+        sigma_max_pa: 0.0,
+        strain_amplitude: 0.0,
+    };
+    for (i, cell) in swt_surface.iter_mut().enumerate() {
+        let ts: Vec<[f64; 6]> = (0..out.len()).map(|k| surface_of(k).at(i)).collect();
+        let pt = swt_point(&ts, &compliance);
+        *cell = pt.value;
+        if pt.value > swt.value_pa {
+            swt = SwtScalars {
+                value_pa: pt.value,
+                at_m: [grid.x(i % n), grid.y(i / n), 0.0],
+                plane_angle_deg: pt.angle_deg,
+                sigma_max_pa: pt.sigma_max,
+                strain_amplitude: pt.strain_amplitude,
+            };
+        }
+    }
+    // Crossland over the states.
+    let alpha = req.crossland_alpha;
+    let (mut crossland_planes, mut crossland_slices, mut crossland) = (Vec::new(), None, None);
+    if out.len() >= 2 {
+        let field_of = |get: &dyn Fn(&StateStress) -> &StressField| -> Vec<f64> {
+            let len = get(&out[0]).len();
+            (0..len)
+                .map(|i| {
+                    let ts: Vec<[f64; 6]> = out.iter().map(|s| get(s).at(i)).collect();
+                    crossland_at(&ts, alpha)
+                })
+                .collect()
+        };
+        for k in 0..depths_m.len() {
+            crossland_planes.push(field_of(&|s: &StateStress| &s.planes[k]));
+        }
+        let slice = |which: usize| -> Vec<f64> {
+            (0..slice_depths.len())
+                .flat_map(|r| {
+                    if which == 0 {
+                        field_of(&|s: &StateStress| &s.along[r])
+                    } else {
+                        field_of(&|s: &StateStress| &s.across[r])
+                    }
+                })
+                .collect()
+        };
+        if !slice_depths.is_empty() {
+            crossland_slices = Some([slice(0), slice(1)]);
+        }
+        let mut b = (f64::NEG_INFINITY, [0.0; 3]);
+        for (k, f) in crossland_planes.iter().enumerate() {
+            for (i, &v) in f.iter().enumerate() {
+                if v > b.0 {
+                    b = (v, [grid.x(i % n), grid.y(i / n), depths_m[k]]);
+                }
+            }
+        }
+        if let Some(sl) = &crossland_slices {
+            for (line, vals) in [(along, &sl[0]), (across, &sl[1])] {
+                for (i, &v) in vals.iter().enumerate() {
+                    if v > b.0 {
+                        b = (v, at_line(line, i % n, slice_depths[i / n]));
+                    }
+                }
+            }
+        }
+        crossland = Some(located(b.0, b.1));
+    }
+    Ok(CaseStress {
+        scalars: StressScalars {
+            states: state_scalars,
+            crossland,
+            crossland_alpha: alpha,
+            crossland_definition: CROSSLAND_DEFINITION.into(),
+            maxima_definition: MAXIMA_DEFINITION.into(),
+            swt,
+            swt_definition: SWT_DEFINITION.into(),
+            slice_depths_m: slice_depths,
+            slice_along: if along_is_row { "x" } else { "y" }.into(),
+            slice_through_m: [grid.x(ix0), grid.y(iy0)],
+        },
+        states: out,
+        crossland_planes,
+        crossland_slices,
+        swt_surface,
+        centre: (ix0, iy0),
+        along_is_row,
+        depths_m,
+        grid,
+        contact_radius_m: a,
+        p_h,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn compliance(e: f64, nu: f64) -> Matrix6<f64> {
+        crate::Isotropic::new(e, nu)
+            .unwrap()
+            .stiffness()
+            .try_inverse()
+            .unwrap()
+    }
+
+    /// Uniaxial cyclic surface stress σxx = ±σa: by hand, on the plane of
+    /// normal (cos t, sin t), σn = σ cos²t and εn = σ (cos²t − ν sin²t)/E;
+    /// σn,max εa = σa² cos²t (cos²t − ν sin²t)/E, largest at t = 0: σa²/E.
+    #[test]
+    fn uniaxial_cycle_gives_sigma_a_squared_over_e_on_the_plane_normal_to_x() {
+        let (e, nu, sa) = (210e9, 0.3, 300e6);
+        let s = compliance(e, nu);
+        let at = swt_point(&[[sa, 0., 0., 0., 0., 0.], [-sa, 0., 0., 0., 0., 0.]], &s);
+        assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12, "{at:?}");
+        assert_eq!(at.angle_deg, 0.0);
+        assert!((at.sigma_max / sa - 1.0).abs() < 1e-12);
+        assert!((at.strain_amplitude / (sa / e) - 1.0).abs() < 1e-12);
+        // The same state turned by 30° about z: the critical plane turns with it.
+        let (sn, cs) = 30f64.to_radians().sin_cos();
+        let r = [sa * cs * cs, sa * sn * sn, 0., 0., 0., sa * sn * cs];
+        let m = r.map(|v| -v);
+        let at = swt_point(&[r, m], &s);
+        assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12);
+        assert!((at.angle_deg - 30.0).abs() < 1e-9, "{at:?}");
+    }
+
+    /// One state: the cycle from the unloaded surface to it and back,
+    /// σn,max = σ, εa = σ/(2E) on the plane normal to x.
+    #[test]
+    fn a_single_state_cycles_from_the_unloaded_surface() {
+        let (e, nu, sg) = (200e9, 0.25, 100e6);
+        let at = swt_point(&[[sg, 0., 0., 0., 0., 0.]], &compliance(e, nu));
+        assert!((at.value / (sg * sg / (2.0 * e)) - 1.0).abs() < 1e-12);
+        // Pure compression never opens a crack: 0.
+        let at = swt_point(&[[-sg, -sg, -sg, 0., 0., 0.]], &compliance(e, nu));
+        assert_eq!(at.value, 0.0);
+    }
+
+    /// A mean tension shifts σmax, not εa: σxx between σm − σa and σm + σa
+    /// gives (σm + σa) σa / E.
+    #[test]
+    fn a_mean_stress_raises_sigma_max_only() {
+        let (e, nu, sm, sa) = (150e9, 0.33, 80e6, 120e6);
+        let at = swt_point(
+            &[
+                [sm + sa, 0., 0., 0., 0., 0.],
+                [sm, 0., 0., 0., 0., 0.],
+                [sm - sa, 0., 0., 0., 0., 0.],
+            ],
+            &compliance(e, nu),
+        );
+        assert!(
+            (at.value / ((sm + sa) * sa / e) - 1.0).abs() < 1e-12,
+            "{at:?}"
+        );
+    }
+}

@@ -1,0 +1,539 @@
+//! Load histories (fretting): a case's load path solved increment by
+//! increment, each from the previous increment's tractions and displacement
+//! (Coulomb friction in increments, PHYSICS.md §5b), and what a fretting study
+//! reads from it: the path's table, the energy dissipated per cycle, the
+//! stiffness after a reversal and the residual shift. Knows the solvers only
+//! through `coupling::solve_step`; writes no files.
+
+use serde::{Deserialize, Serialize};
+
+use crate::base::geometry::covered_area;
+use crate::error::SolverError;
+use crate::model::radii::{apparent_radius, friction_reserve};
+use crate::model::spec::{CaseSpec, LoadHistory};
+use crate::model::surface::Terrain;
+use crate::operators::operator::{X, Y, Z};
+use crate::solve::coupling::{solve_step, ContactState, Previous, Step, Target};
+use crate::solve::normal::{NormalProblem, NormalSolution};
+use crate::solve::resident::Resident;
+
+/// How the dissipated energy is computed.
+pub const DISSIPATION_DEFINITION: &str = "energy dissipated by slip, sum over increments and cells of (q_prev + q)/2 . (delta_t increment - u increment) dA, q the shear tractions and u the total tangential surface displacement (trapezoidal rule for the integral of q . ds, ds the slip increment of the substrate relative to the sphere); per cycle: over the last two segments that return to the same turning point";
+
+/// One row of a load history: the state at the end of an increment.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HistoryStep {
+    /// Increment number; 0 is the state after frictionless normal loading.
+    pub step: usize,
+    /// Segment of the path the increment belongs to (0 for step 0).
+    pub segment: usize,
+    /// Normal load recovered from the pressure, N.
+    pub normal_force_n: f64,
+    /// Tangential force recovered from the tractions, x and y, N.
+    pub force_n: [f64; 2],
+    /// Rigid tangential shift δt of the sphere from the start of the path, x and y, m.
+    pub delta_t_m: [f64; 2],
+    /// Rigid-body approach δz, m.
+    pub delta_z_m: f64,
+    /// Contact area (cells with p > 0), m².
+    pub contact_area_m2: f64,
+    /// Stick area (contact cells with |q| < μp), m².
+    pub stick_area_m2: f64,
+    /// Apparent stick radius (the case's `stick_radius_m` definition, `solver.radii`), m.
+    pub stick_radius_m: f64,
+    /// Energy dissipated in this increment ([`DISSIPATION_DEFINITION`]), J.
+    pub dissipated_j: f64,
+    /// The increment's solves converged.
+    pub converged: bool,
+}
+
+/// A solved load history and the quantities a fretting study reads from it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HistoryOutput {
+    /// Unit vector of the case's force direction (positive tangential ratios).
+    pub direction: [f64; 2],
+    /// The state after every increment, step 0 first.
+    pub steps: Vec<HistoryStep>,
+    /// Step index of every turning point (the path's start first).
+    pub turning_steps: Vec<usize>,
+    /// Energy dissipated over the last full cycle (two segments that return
+    /// to the same turning point), J; `None` if the path has no cycle.
+    pub dissipated_energy_per_cycle_j: Option<f64>,
+    /// Area of the same cycle's loop, ∮ F · dδt (trapezoidal rule), J: the
+    /// independent check of `dissipated_energy_per_cycle_j`.
+    pub loop_area_per_cycle_j: Option<f64>,
+    /// Secant tangential stiffness of the first increment after the last
+    /// reversal of the tangential force, along the force direction, N/m.
+    pub reversal_stiffness_n_per_m: Option<f64>,
+    /// δt along the force direction where F crosses zero on the last
+    /// unloading from a positive force (linear between increments), m.
+    pub residual_delta_t_m: Option<f64>,
+    /// Largest |ΔA Σq − F| over the increments, relative to μP.
+    pub force_error_max: f64,
+    /// Dissipated energy summed over the whole path, J.
+    pub dissipated_total_j: f64,
+    /// The last full cycle's force amplitude F*: the largest |F| along the
+    /// force direction over it, N.
+    #[serde(default)]
+    pub force_amplitude_n: Option<f64>,
+    /// The last full cycle's shift amplitude δ*: the largest |δt| along the
+    /// force direction over it, m.
+    #[serde(default)]
+    pub shift_amplitude_m: Option<f64>,
+    /// The energy ratio A = W / (4 F* δ*) of the last full cycle (Fouvry's
+    /// criterion: 0.2 at the transition to gross slip for a sphere).
+    #[serde(default)]
+    pub energy_ratio: Option<f64>,
+    /// The slip regime over the path's full cycles ([`SLIP_REGIME_DEFINITION`]):
+    /// `partial`, `gross`, or `mixed` when it changes between cycles.
+    #[serde(default)]
+    pub regime: Option<String>,
+}
+
+/// How [`HistoryOutput::regime`] is decided.
+pub const SLIP_REGIME_DEFINITION: &str = "a full cycle is in gross slip when at some increment of it no contact cell sticks (every traction on its friction disc: the whole contact slides), in partial slip otherwise; the path is `partial` or `gross` when all its full cycles are, `mixed` when they differ";
+
+/// The tractions of the state at a turning point of the path (what the
+/// stresses below the surface of a load history are computed from).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TurningState {
+    /// The increment (a row of [`HistoryOutput::steps`]).
+    pub step: usize,
+    /// Pressure, Pa (row major, as [`crate::Fields`]).
+    pub p: Vec<f64>,
+    /// Shear traction x, Pa.
+    pub qx: Vec<f64>,
+    /// Shear traction y, Pa.
+    pub qy: Vec<f64>,
+}
+
+impl TurningState {
+    fn of(step: usize, state: &ContactState) -> Self {
+        TurningState {
+            step,
+            p: state.p.clone(),
+            qx: state.tangential.qx.clone(),
+            qy: state.tangential.qy.clone(),
+        }
+    }
+}
+
+/// Sums of the solves over all increments.
+pub(crate) struct HistoryState {
+    /// The state after the last increment (iteration counts summed over all).
+    pub last: ContactState,
+    /// Every increment converged.
+    pub converged: bool,
+    /// The path's table and its reductions.
+    pub output: HistoryOutput,
+    /// The states at the turning points, the start first.
+    pub turning: Vec<TurningState>,
+}
+
+/// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
+/// bracket only with coupling).
+fn displacement(
+    res: &mut Resident,
+    coupling: bool,
+    (qx, qy): (&[f64], &[f64]),
+    p: &[f64],
+    p0: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let len = qx.len();
+    let (mut ux, mut uy) = (vec![0.0; len], vec![0.0; len]);
+    if coupling {
+        let dp: Vec<f64> = p.iter().zip(p0).map(|(a, b)| a - b).collect();
+        res.operator.apply(
+            &[(X, qx), (Y, qy), (Z, &dp)],
+            &mut [(X, &mut ux), (Y, &mut uy)],
+        );
+    } else {
+        res.operator
+            .apply(&[(X, qx), (Y, qy)], &mut [(X, &mut ux), (Y, &mut uy)]);
+    }
+    (ux, uy)
+}
+
+/// Solves the load path `history` of `spec` from the frictionless normal
+/// solution `normal0` (under the first turning point's normal load) of the
+/// separation `h0`. `check` is applied to every increment's pressure (the
+/// contact must stay inside the domain).
+pub(crate) fn solve_history(
+    res: &mut Resident,
+    spec: &CaseSpec,
+    history: &LoadHistory,
+    (h0, terrain): (&[f64], &Terrain),
+    normal0: NormalSolution,
+    check: impl Fn(&[f64]) -> Result<(), SolverError>,
+) -> Result<HistoryState, SolverError> {
+    let grid = spec.grid;
+    let (len, da) = (grid.len(), grid.cell_area());
+    let num = spec.numerics_in_effect();
+    let mu = spec.load.friction;
+    let angle = spec.load.angle_deg.to_radians();
+    let dir = [angle.cos(), angle.sin()];
+    let points = history.turning_points(&spec.load);
+    let displacement_control = history.displacement_controlled();
+    let steps = history.steps_per_segment;
+
+    // State after frictionless normal loading.
+    let p0 = normal0.p.clone();
+    let mut last = ContactState {
+        p: normal0.p,
+        approach: normal0.approach,
+        tangential: crate::solve::tangential::TangentialSolution {
+            qx: vec![0.0; len],
+            qy: vec![0.0; len],
+            sx: vec![0.0; len],
+            sy: vec![0.0; len],
+            stick: vec![false; len],
+            shift: [0.0; 2],
+            report: Default::default(),
+        },
+        normal_report: normal0.report,
+        normal_iterations: normal0.report.iterations,
+        tangential_iterations: 0,
+        coupling_iterations: 0,
+        coupling_change: 0.0,
+        coupling_converged: true,
+    };
+    let mut converged = normal0.report.converged;
+    let (mut ux, mut uy) = (vec![0.0; len], vec![0.0; len]);
+    let mut delta_t = [0.0_f64; 2];
+    // Largest |δt| so far and the last increment's |Δδt| (tolerance scale).
+    let (mut delta_t_max, mut last_increment) = (0.0_f64, 0.0_f64);
+    let mut normal_iterations = last.normal_iterations;
+    let (mut tangential_iterations, mut coupling_iterations) = (0, 0);
+    let mut rows = vec![row(
+        spec,
+        terrain,
+        &last,
+        &StepSums {
+            step: 0,
+            segment: 0,
+            delta_t,
+            dissipated: 0.0,
+            converged,
+        },
+    )];
+    rows[0].stick_area_m2 = rows[0].contact_area_m2;
+    let mut force_error_max: f64 = 0.0;
+    let mut turning_steps = vec![0];
+    let mut turning = vec![TurningState::of(0, &last)];
+    let (mut p_prev, mut f_prev) = points[0];
+
+    for (segment, pair) in points.windows(2).enumerate() {
+        let ((pa, fa), (pb, fb)) = (pair[0], pair[1]);
+        for m in 1..=steps {
+            crate::base::progress::increment(segment * steps + m, (points.len() - 1) * steps)?;
+            let t = m as f64 / steps as f64;
+            let (p_k, f_k) = if m == steps {
+                (pb, fb)
+            } else {
+                (pa + t * (pb - pa), fa + t * (fb - fa))
+            };
+            let step_no = rows.len();
+            if p_k == p_prev && f_k == f_prev {
+                // A hold: nothing changes.
+                let mut r = rows[step_no - 1].clone();
+                r.step = step_no;
+                r.segment = segment + 1;
+                r.dissipated_j = 0.0;
+                rows.push(r);
+                continue;
+            }
+            // The normal solve at the new load, from the last pressure (with
+            // coupling, under the last tractions' normal displacement).
+            let normal = if p_k == p_prev {
+                NormalSolution {
+                    p: last.p.clone(),
+                    uz: Vec::new(),
+                    approach: last.approach,
+                    report: crate::solve::normal::NormalReport {
+                        iterations: 0,
+                        ..last.normal_report
+                    },
+                }
+            } else {
+                let mut hq = Vec::new();
+                if num.coupling {
+                    hq = vec![0.0; len];
+                    res.operator.apply(
+                        &[(X, &last.tangential.qx), (Y, &last.tangential.qy)],
+                        &mut [(Z, &mut hq)],
+                    );
+                }
+                res.solve_normal(&NormalProblem {
+                    extra_gap: num.coupling.then_some(&hq[..]),
+                    tolerance: num.tolerance,
+                    max_iterations: num.max_iterations,
+                    p_init: Some(&last.p),
+                    ..NormalProblem::new(h0, p_k)
+                })?
+            };
+            // Force control: the force at the increment's end; displacement
+            // control: the shift still to impose to reach the target, the
+            // force a result.
+            let goal = [f_k * dir[0], f_k * dir[1]];
+            let target = if displacement_control {
+                Target::Shift([goal[0] - delta_t[0], goal[1] - delta_t[1]])
+            } else {
+                Target::Force(goal)
+            };
+            // The KKT tolerance relative to the loop's δt (see Step::tolerance_scale),
+            // with the last increment's |Δδt| as the estimate of this one's.
+            let tolerance_scale = if last_increment > 0.0 {
+                (delta_t_max / last_increment).max(1.0)
+            } else {
+                1.0
+            };
+            // The previous tractions; the projection shifts them onto the
+            // new force. (Adding the force increment spread like the
+            // pressure cost 7–9 % more iterations on Table 1a at 128².)
+            let start = (&last.tangential.qx[..], &last.tangential.qy[..]);
+            let state = solve_step(
+                res,
+                spec,
+                h0,
+                normal,
+                &Step {
+                    normal_force_n: p_k,
+                    target,
+                    previous: Some(Previous {
+                        start,
+                        u: (&ux, &uy),
+                        p0: &p0,
+                    }),
+                    tolerance_scale,
+                },
+            )?;
+            check(&state.p)?;
+            let (vx, vy) = displacement(
+                res,
+                num.coupling,
+                (&state.tangential.qx, &state.tangential.qy),
+                &state.p,
+                &p0,
+            );
+            let shift = state.tangential.shift;
+            // Dissipation: ∫ q · ds over the increment by the trapezoidal
+            // rule, ds = dδt − du the slip increment of the sphere relative
+            // to the substrate, negated (q opposes the substrate's slip).
+            let (qx0, qy0) = (&last.tangential.qx, &last.tangential.qy);
+            let (qx1, qy1) = (&state.tangential.qx, &state.tangential.qy);
+            let mut work = 0.0;
+            for i in 0..len {
+                let (mx, my) = (0.5 * (qx0[i] + qx1[i]), 0.5 * (qy0[i] + qy1[i]));
+                if mx != 0.0 || my != 0.0 {
+                    work += mx * (shift[0] - (vx[i] - ux[i])) + my * (shift[1] - (vy[i] - uy[i]));
+                }
+            }
+            delta_t = [delta_t[0] + shift[0], delta_t[1] + shift[1]];
+            last_increment = shift[0].hypot(shift[1]);
+            delta_t_max = delta_t_max.max(delta_t[0].hypot(delta_t[1]));
+            let step_converged = state.normal_report.converged
+                && state.tangential.report.converged
+                && state.coupling_converged;
+            converged &= step_converged;
+            normal_iterations += state.normal_iterations;
+            tangential_iterations += state.tangential_iterations;
+            coupling_iterations += state.coupling_iterations;
+            let r = row(
+                spec,
+                terrain,
+                &state,
+                &StepSums {
+                    step: step_no,
+                    segment: segment + 1,
+                    delta_t,
+                    dissipated: work * da,
+                    converged: step_converged,
+                },
+            );
+            if !displacement_control {
+                let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
+                force_error_max = force_error_max.max(ferr);
+            }
+            rows.push(r);
+            (ux, uy) = (vx, vy);
+            last = state;
+            (p_prev, f_prev) = (p_k, f_k);
+        }
+        turning_steps.push(rows.len() - 1);
+        turning.push(TurningState::of(rows.len() - 1, &last));
+    }
+    // The final state's shift is δt from the start of the path, not the
+    // last increment's.
+    last.tangential.shift = delta_t;
+    last.normal_iterations = normal_iterations;
+    last.tangential_iterations = tangential_iterations;
+    last.coupling_iterations = coupling_iterations;
+    let output = reduce_history(dir, rows, &points, turning_steps, force_error_max);
+    Ok(HistoryState {
+        last,
+        converged,
+        output,
+        turning,
+    })
+}
+
+/// What a row needs besides the contact state.
+struct StepSums {
+    step: usize,
+    segment: usize,
+    delta_t: [f64; 2],
+    dissipated: f64,
+    converged: bool,
+}
+
+/// The table row of a solved increment on the surface's `terrain`.
+fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums) -> HistoryStep {
+    let grid = spec.grid;
+    let (len, da) = (grid.len(), grid.cell_area());
+    let p = &state.p;
+    let tan = &state.tangential;
+    let mu = spec.load.friction;
+    let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
+    let stick: Vec<bool> = (0..len).map(|i| contact[i] && tan.stick[i]).collect();
+    let count = |v: &[bool]| covered_area(v, terrain.cover.as_deref(), da);
+    let stick_radius = if stick.iter().any(|&b| b) {
+        let reserve = friction_reserve(mu, p, (&tan.qx, &tan.qy));
+        apparent_radius(spec.numerics.radii, &grid, &stick, &reserve, terrain)
+    } else {
+        0.0
+    };
+    HistoryStep {
+        step: sums.step,
+        segment: sums.segment,
+        normal_force_n: p.iter().sum::<f64>() * da,
+        force_n: [
+            tan.qx.iter().sum::<f64>() * da,
+            tan.qy.iter().sum::<f64>() * da,
+        ],
+        delta_t_m: sums.delta_t,
+        delta_z_m: state.approach,
+        contact_area_m2: count(&contact),
+        stick_area_m2: count(&stick),
+        stick_radius_m: stick_radius,
+        dissipated_j: sums.dissipated,
+        converged: sums.converged,
+    }
+}
+
+/// The cycle, reversal and residual-shift reductions of a solved path.
+fn reduce_history(
+    dir: [f64; 2],
+    steps: Vec<HistoryStep>,
+    points: &[(f64, f64)],
+    turning_steps: Vec<usize>,
+    force_error_max: f64,
+) -> HistoryOutput {
+    let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
+    let same = |a: (f64, f64), b: (f64, f64)| {
+        let scale = a.0.abs().max(b.0.abs());
+        (a.0 - b.0).abs() <= 1e-12 * scale && (a.1 - b.1).abs() <= 1e-12 * scale
+    };
+    // The last full cycle: segments j, j+1 that return to turning point j.
+    let cycle = (0..points.len().saturating_sub(2))
+        .rev()
+        .find(|&j| same(points[j], points[j + 2]) && !same(points[j], points[j + 1]))
+        .map(|j| (turning_steps[j], turning_steps[j + 2]));
+    let (dissipated, loop_area) = match cycle {
+        Some((s0, s1)) => {
+            let d: f64 = steps[s0 + 1..=s1].iter().map(|r| r.dissipated_j).sum();
+            let area: f64 = (s0 + 1..=s1)
+                .map(|k| {
+                    let (a, b) = (&steps[k - 1], &steps[k]);
+                    (0..2)
+                        .map(|c| {
+                            0.5 * (a.force_n[c] + b.force_n[c]) * (b.delta_t_m[c] - a.delta_t_m[c])
+                        })
+                        .sum::<f64>()
+                })
+                .sum();
+            (Some(d), Some(area))
+        }
+        None => (None, None),
+    };
+    // The last reversal: a turning point where F along the direction turns back.
+    let reversal = (1..points.len().saturating_sub(1)).rev().find(|&j| {
+        let (d0, d1) = (points[j].1 - points[j - 1].1, points[j + 1].1 - points[j].1);
+        d0 * d1 < 0.0
+    });
+    let reversal_stiffness = reversal.and_then(|j| {
+        let s = turning_steps[j];
+        let (a, b) = (steps.get(s)?, steps.get(s + 1)?);
+        let dd = along(b.delta_t_m) - along(a.delta_t_m);
+        (dd != 0.0).then(|| (along(b.force_n) - along(a.force_n)) / dd)
+    });
+    // The last unloading from a positive force through zero.
+    let residual = (0..points.len().saturating_sub(1))
+        .rev()
+        .find(|&j| points[j].1 > 0.0 && points[j + 1].1 < 0.0)
+        .and_then(|j| {
+            (turning_steps[j] + 1..=turning_steps[j + 1]).find_map(|k| {
+                let (a, b) = (&steps[k - 1], &steps[k]);
+                let (fa, fb) = (along(a.force_n), along(b.force_n));
+                (fa > 0.0 && fb <= 0.0).then(|| {
+                    let t = fa / (fa - fb);
+                    along(a.delta_t_m) + t * (along(b.delta_t_m) - along(a.delta_t_m))
+                })
+            })
+        });
+    let dissipated_total_j = steps.iter().map(|r| r.dissipated_j).sum();
+    // Amplitudes and the energy ratio of the last cycle.
+    let (force_amplitude_n, shift_amplitude_m, energy_ratio) = match (cycle, dissipated) {
+        (Some((s0, s1)), Some(w)) => {
+            let rows = &steps[s0..=s1];
+            let f = rows
+                .iter()
+                .map(|r| along(r.force_n).abs())
+                .fold(0.0, f64::max);
+            let d = rows
+                .iter()
+                .map(|r| along(r.delta_t_m).abs())
+                .fold(0.0, f64::max);
+            let ratio = (f > 0.0 && d > 0.0).then(|| w / (4.0 * f * d));
+            (Some(f), Some(d), ratio)
+        }
+        _ => (None, None, None),
+    };
+    // The regime of every full cycle, from the last one back.
+    let mut regimes = Vec::new();
+    let mut j = cycle.map(|(s0, _)| turning_steps.iter().position(|&t| t == s0));
+    while let Some(Some(k)) = j {
+        if k + 2 >= points.len() || !same(points[k], points[k + 2]) {
+            break;
+        }
+        let (s0, s1) = (turning_steps[k], turning_steps[k + 2]);
+        let gross = steps[s0 + 1..=s1]
+            .iter()
+            .any(|r| r.stick_area_m2 == 0.0 && r.contact_area_m2 > 0.0);
+        regimes.push(gross);
+        j = (k >= 2).then(|| Some(k - 2));
+    }
+    let regime = (!regimes.is_empty()).then(|| {
+        if regimes.iter().all(|&g| g) {
+            "gross".to_string()
+        } else if regimes.iter().all(|&g| !g) {
+            "partial".to_string()
+        } else {
+            "mixed".to_string()
+        }
+    });
+    HistoryOutput {
+        direction: dir,
+        steps,
+        turning_steps,
+        dissipated_energy_per_cycle_j: dissipated,
+        loop_area_per_cycle_j: loop_area,
+        reversal_stiffness_n_per_m: reversal_stiffness,
+        residual_delta_t_m: residual,
+        force_error_max,
+        dissipated_total_j,
+        force_amplitude_n,
+        shift_amplitude_m,
+        energy_ratio,
+        regime,
+    }
+}
