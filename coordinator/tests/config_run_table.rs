@@ -2,22 +2,10 @@
 
 use coordinator::config::Config;
 
-const BASE: &str = r#"
-[grid]
-points = 32
-spacing_um = 200.0
-
-[indenter]
-radius_mm = 200.0
-
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.3
-
-[sweep]
-materials = ["Cu"]
-"#;
+const BASE: &str = concat!(
+    include_str!("../../tests/configs/table1c-coarse.toml"),
+    "\n[sweep]\nmaterials = [\"Cu\"]\n"
+);
 
 fn err(text: &str) -> String {
     format!("{:#}", Config::parse(text, &[]).unwrap_err())

@@ -19,29 +19,17 @@ use worker::fault_injection::{
 
 const EXE: &str = env!("CARGO_BIN_EXE_mpcontact");
 
-const CONFIG: &str = r#"
-[grid]
-points = 32
-spacing_um = 200.0
-
-[indenter]
-radius_mm = 200.0
-
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.3
-
+const CONFIG: &str = concat!(
+    include_str!("../../tests/configs/table1c-coarse.toml"),
+    r#"
 [sweep]
 materials = ["Cu", "Ni"]
 surfaces = ["flat", "circle-A"]
 angles_deg = { start = 0, stop = 90, step = 45 }
 
-[solver]
-coupling = false
-tolerance = 1e-6
-max_iterations = 2000
-"#;
+"#,
+    include_str!("../../tests/configs/solver-fast.toml")
+);
 
 const CASES: usize = 12;
 
@@ -1143,29 +1131,17 @@ fn issue16_a_fretting_sweep_reports_energy_per_cycle_and_per_case_loops() {
 
 /// A sweep whose cases all come out `ok` (flat surfaces only; circle-A on
 /// this coarse grid has unresolved slip zones), 14 cases.
-const ALL_OK_CONFIG: &str = r#"
-[grid]
-points = 32
-spacing_um = 200.0
-
-[indenter]
-radius_mm = 200.0
-
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.3
-
+const ALL_OK_CONFIG: &str = concat!(
+    include_str!("../../tests/configs/table1c-coarse.toml"),
+    r#"
 [sweep]
 materials = ["Cu", "Ni"]
 surfaces = ["flat"]
 angles_deg = { start = 0, stop = 180, step = 30 }
 
-[solver]
-coupling = false
-tolerance = 1e-6
-max_iterations = 2000
-"#;
+"#,
+    include_str!("../../tests/configs/solver-fast.toml")
+);
 
 /// Statuses of results.csv by case id.
 fn statuses(out: &Path) -> BTreeMap<String, String> {
@@ -1664,29 +1640,17 @@ fn issue39_orientations_are_the_single_crystals_and_map_the_triangle() {
 
 /// Two cases of Cu at 32² (the sweep above's flat surface at 0° and 45°),
 /// the stresses asked for on the surface and at 1 mm and on 8-row slices.
-const STRESS_SWEEP: &str = r#"
-[grid]
-points = 32
-spacing_um = 200.0
-
-[indenter]
-radius_mm = 200.0
-
-[load]
-normal_n = 6000.0
-friction = 0.3
-tangential_ratio = 0.3
-
+const STRESS_SWEEP: &str = concat!(
+    include_str!("../../tests/configs/table1c-coarse.toml"),
+    r#"
 [sweep]
 materials = ["Cu"]
 surfaces = ["flat"]
 angles_deg = [0.0, 45.0]
 
-[solver]
-coupling = false
-tolerance = 1e-6
-max_iterations = 2000
-"#;
+"#,
+    include_str!("../../tests/configs/solver-fast.toml")
+);
 
 const STRESS_SECTION: &str = "\n[stress]\ndepths_um = [0.0, 1000.0]\nslice_rows = 8\n";
 
@@ -1891,21 +1855,26 @@ fn issue38_a_fretting_sweep_keeps_the_turning_states_scalars_and_resumes() {
     );
 }
 
-/// `solver.radii = "moments"` (issue #34) changes the radii and μa only: the
-/// sweep's summary states the definition, every other physics column of
-/// `results.csv` (δt, areas, pressures, iterations, the paper's whole-cell
-/// radii and μa) is the default run's to the bit, flat μa stays μ within the
-/// discretisation (both definitions), and the patterned μa moves.
+/// `solver.radii = "moments"` (issue #34), the default since issue #47,
+/// against the paper's `"hull"`: the definition changes the radii and μa
+/// only. The sweep's summary states the definition (the moments' when the
+/// config says nothing), every other physics column of `results.csv` (δt,
+/// areas, pressures, iterations, the paper's whole-cell radii and μa) is
+/// the hull run's to the bit, flat μa stays μ within the discretisation
+/// (both definitions), and the patterned μa moves.
 #[test]
 fn issue34_moment_radii_change_the_radii_and_mu_a_only() {
     let dir = scratch("radii");
-    check_ok(&sweep_cmd(&dir, "hull", 1, "rh").output().unwrap(), "hull");
     check_ok(
-        &sweep_cmd(&dir, "moments", 1, "rm")
-            .args(["--set", "solver.radii=moments"])
+        &sweep_cmd(&dir, "hull", 1, "rh")
+            .args(["--set", "solver.radii=hull"])
             .output()
             .unwrap(),
-        "moments",
+        "hull",
+    );
+    check_ok(
+        &sweep_cmd(&dir, "moments", 1, "rm").output().unwrap(),
+        "moments (the default)",
     );
     let (h, m) = (dir.join("hull"), dir.join("moments"));
     let def = |o: &Path| {

@@ -10,27 +10,13 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 
-# Hertz / Cattaneo–Mindlin on isotropic Fe (paper Table 1(a) at 96², 4 µm
+# Hertz / Cattaneo–Mindlin on isotropic Fe (paper Table 1(a), the fragment
+# tests/configs/table1a-fe.toml that the CLI tests share) at 96², 4 µm
 # cells: a ≈ 105 µm spans ~26 cells and the contact stays well inside the
-# 384 µm domain).
-MINDLIN = """
-[grid]
-points = 96
-spacing_um = 4.0
+# 384 µm domain.
+TABLE_1A_FE = (REPO / "tests" / "configs" / "table1a-fe.toml").read_text()
 
-[indenter]
-radius_mm = 18.0
-
-[load]
-normal_n = 20.0
-friction = 0.28571
-tangential_ratio = {ratio}
-
-[sweep]
-materials = ["Fe"]
-surfaces = ["flat"]
-angles_deg = [{angle}]
-
+MINDLIN_SOLVER = """
 [solver]
 coupling = {coupling}
 tolerance = 1e-10
@@ -40,7 +26,15 @@ max_iterations = 5000
 
 
 def mindlin_text(ratio=0.6, angle=0.0, coupling="false"):
-    return MINDLIN.format(ratio=ratio, angle=angle, coupling=coupling)
+    text = TABLE_1A_FE
+    for old, new in (
+        ("tangential_ratio = 0.6", f"tangential_ratio = {ratio}"),
+        ("angles_deg = [30.0]", f"angles_deg = [{angle}]"),
+    ):
+        assert old in text, f"tests/configs/table1a-fe.toml has no '{old}'"
+        text = text.replace(old, new)
+    grid = "[grid]\npoints = 96\nspacing_um = 4.0\n\n"
+    return grid + text + MINDLIN_SOLVER.format(coupling=coupling)
 
 
 # Paper Table 1(c) loading (R = 200 mm, P = 6 kN, μ = 0.3, F = 0.6 μP) on a

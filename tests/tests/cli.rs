@@ -37,24 +37,10 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
         .unwrap()
 }
 
-const SMALL: &str = r#"
-[grid]
-points = 64
-spacing_um = 4.0
-
-[indenter]
-radius_mm = 18.0
-
-[load]
-normal_n = 20.0
-friction = 0.28571
-tangential_ratio = 0.6
-
-[sweep]
-materials = ["Fe"]
-surfaces = ["flat"]
-angles_deg = [30.0]
-"#;
+const SMALL: &str = concat!(
+    "[grid]\npoints = 64\nspacing_um = 4.0\n\n",
+    include_str!("../configs/table1a-fe.toml")
+);
 
 #[test]
 fn solve_writes_case_json_nine_npy_fields_and_five_maps() {
