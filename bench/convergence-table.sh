@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Issue #15's grid-convergence table: μa of configs/paper-1c-patterns.toml
 # (Cu, 7.68 mm domain, coupled) at cell sizes 30 / 20 / 15 / 10 µm, with the
-# sub-cell radii (mu_a, the default) beside the paper's whole-cell radii
-# (mu_a_cells). Prints a Markdown table. Usage: bench/convergence-table.sh [OUT]
+# sub-cell hull radii (mu_a with solver.radii=hull, set below: the table of
+# issue #15) beside the paper's whole-cell radii (mu_a_cells). Prints a
+# Markdown table. Usage: bench/convergence-table.sh [OUT]
 # RADII=moments bench/convergence-table.sh [OUT]: the sub-cell row with the
-# apparent radii from second moments (solver.radii, issue #34) instead of the hull.
+# apparent radii from second moments (solver.radii, issue #34; the default
+# since issue #47) instead of the hull.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-target/convergence-table}

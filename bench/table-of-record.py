@@ -5,6 +5,9 @@ convergence ladder, e.g.
     mpcontact run configs/paper-1c-sweep.toml --refine 2 --out paper-refine2
     python3 bench/table-of-record.py paper-refine2
 
+(that config sets the paper's hull radii; `--set solver.radii=moments` gives
+the second moments' table, the default definition elsewhere.)
+
 Prints, per material x surface, μa ± error over the force angles, whether its
 variation over angle is resolved, and the paper's qualitative claims checked
 against the error bars. Standard library only."""

@@ -165,7 +165,14 @@ fn every_example_loads_and_solves_on_a_small_grid() {
                 path.display()
             );
             let mu = out.scalars.mu_a.expect("a tangential load gives μa");
-            assert!(mu > 0.1 && mu < 1.0, "{}: {key}: μa = {mu}", path.display());
+            // A plausible μa, not grid noise (a stick zone of a few cells
+            // gave 434, #20 item 8). A few separate contacts lift it above
+            // 1 (the paper's Ni on sparse islands: up to 2.3 with the hull,
+            // docs/validation.md): the height map's five bumps give 1.03
+            // with the second moments, the default since #47 (0.48 with the
+            // hull), their stick reserve spread over the bumps as the load
+            // is (c/a = 0.92).
+            assert!(mu > 0.1 && mu < 1.5, "{}: {key}: μa = {mu}", path.display());
             solved += 1;
         }
     }

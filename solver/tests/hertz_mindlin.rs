@@ -140,10 +140,10 @@ fn issue20_item8_zones_the_grid_cannot_resolve_are_refused() {
     );
 }
 
-/// Issue #15: the sub-cell apparent radii converge to Hertz's a and
-/// Mindlin's c at a measured order ≥ 1.5 and are within 0.1 % at 256² (the
-/// paper's whole-cell radii: first order, 0.6 % off at 256²). Table 1a,
-/// uncoupled, on its 256 µm domain.
+/// Issue #15: the sub-cell apparent radii (the hull's, `solver.radii =
+/// "hull"`) converge to Hertz's a and Mindlin's c at a measured order ≥ 1.5
+/// and are within 0.1 % at 256² (the paper's whole-cell radii: first order,
+/// 0.6 % off at 256²). Table 1a, uncoupled, on its 256 µm domain.
 ///
 /// The errors also carry a part that oscillates with where the boundary
 /// falls between cell centres (docs/validation.md has every grid from 32² to
@@ -154,9 +154,9 @@ fn issue15_subcell_radii_converge_to_hertz_and_mindlin() {
     let mut cache = KernelCache::new();
     let m = mindlin();
     let mut solve = |n: usize| {
-        let s = solve_case(&table_1a_fe(n, 256.0 / n as f64, false, 0.6), &mut cache)
-            .unwrap()
-            .scalars;
+        let mut spec = table_1a_fe(n, 256.0 / n as f64, false, 0.6);
+        spec.numerics.radii = solver::Radii::Hull;
+        let s = solve_case(&spec, &mut cache).unwrap().scalars;
         assert!(s.converged);
         let errs = (
             rel(s.contact_radius_m, m.a),
@@ -209,22 +209,22 @@ fn light_tangential_loads_converge_to_cattaneo_mindlin() {
     }
 }
 
-/// `solver.radii = "moments"` (issue #34): the radii from the second
-/// moments of p and of μp − |q| on the stick cells are Hertz's a and
-/// Mindlin's c on Table 1a uncoupled, and flat isotropic μa is μ with them,
-/// as with the hull's (measured at 256² of 1 µm: a −1.1e-5, c −3.5e-4, μa
-/// 0.28535 against the hull's 0.28532, μ = 0.28571). Everything else about
-/// the case is the same solve: δt, areas and iterations do not depend on
-/// the definition.
+/// `solver.radii = "moments"` (issue #34; the default since issue #47): the
+/// radii from the second moments of p and of μp − |q| on the stick cells
+/// are Hertz's a and Mindlin's c on Table 1a uncoupled, and flat isotropic
+/// μa is μ with them, as with the hull's (measured at 256² of 1 µm: a
+/// −1.1e-5, c −3.5e-4, μa 0.28535 against the hull's 0.28532, μ = 0.28571).
+/// Everything else about the case is the same solve: δt, areas and
+/// iterations do not depend on the definition.
 #[test]
 fn moment_radii_are_hertz_and_mindlin_and_give_mu_on_flat() {
     let mut cache = KernelCache::new();
     let m = mindlin();
-    let hull = solve_case(&table_1a_fe(256, 1.0, false, 0.6), &mut cache)
-        .unwrap()
-        .scalars;
     let mut spec = table_1a_fe(256, 1.0, false, 0.6);
-    spec.numerics.radii = solver::Radii::Moments;
+    spec.numerics.radii = solver::Radii::Hull;
+    let hull = solve_case(&spec, &mut cache).unwrap().scalars;
+    let spec = table_1a_fe(256, 1.0, false, 0.6);
+    assert_eq!(spec.numerics.radii, solver::Radii::Moments, "the default");
     let s = solve_case(&spec, &mut cache).unwrap().scalars;
     println!(
         "moments: a {:.3e}, c {:.3e} off; μa {:.5} (hull {:.5})",

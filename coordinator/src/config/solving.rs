@@ -28,8 +28,9 @@ pub struct SolverCfg {
     /// Coupling loop budget.
     #[serde(default = "default_citer")]
     pub max_coupling_iterations: usize,
-    /// Definition of the apparent radii of μa.
-    #[serde(default)]
+    /// Definition of the apparent radii of μa: `"moments"` (the default)
+    /// or `"hull"` (the paper's, pinned by the configs that reproduce it).
+    #[serde(default = "default_radii")]
     pub radii: solver::Radii,
 }
 
@@ -52,6 +53,9 @@ fn default_ctol() -> f64 {
 fn default_citer() -> usize {
     Numerics::default().max_coupling_iterations
 }
+fn default_radii() -> solver::Radii {
+    Numerics::default().radii
+}
 
 impl Default for SolverCfg {
     fn default() -> Self {
@@ -62,7 +66,7 @@ impl Default for SolverCfg {
             max_iterations: default_iter(),
             coupling_tolerance: default_ctol(),
             max_coupling_iterations: default_citer(),
-            radii: solver::Radii::default(),
+            radii: default_radii(),
         }
     }
 }
@@ -145,6 +149,32 @@ pub(super) fn config_key(param: &str) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::super::fixtures::{err, BASE};
+    use super::super::Config;
+    use solver::Radii;
+
+    /// Issue #47: a config that says nothing gets the second moments, the
+    /// solver's default; `radii = "hull"` (the paper configs) and `--set
+    /// solver.radii=hull` get the hull, in every case and in the echo a
+    /// resume compares.
+    #[test]
+    fn issue47_radii_default_to_moments_and_hull_stays_available() {
+        let radii = |c: &Config| {
+            let cases = c.cases().unwrap();
+            assert!(cases
+                .iter()
+                .all(|(_, s)| s.numerics.radii == c.solver.radii));
+            c.solver.radii
+        };
+        let default = Config::parse(BASE, &[]).unwrap();
+        assert_eq!(radii(&default), Radii::Moments);
+        assert_eq!(default.solver.radii, solver::Numerics::default().radii);
+        assert!(default.to_toml().contains("radii = \"moments\""));
+        let pinned = Config::parse(&format!("{BASE}\n[solver]\nradii = \"hull\"\n"), &[]).unwrap();
+        assert_eq!(radii(&pinned), Radii::Hull);
+        assert!(pinned.to_toml().contains("radii = \"hull\""));
+        let set = Config::parse(BASE, &["solver.radii=hull".to_string()]).unwrap();
+        assert_eq!(radii(&set), Radii::Hull);
+    }
 
     #[test]
     fn issue20_item6_case_timeouts_are_bounded() {

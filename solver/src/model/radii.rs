@@ -10,22 +10,25 @@ use crate::base::grid::Grid;
 use crate::model::surface::Terrain;
 
 /// The definition of the apparent contact and stick radii that μa and K_E
-/// use (PHYSICS.md §7 leaves it to the product, the convex hull being the
-/// default; docs/physics-choices.md, "Reported quantities": apparent radii
-/// from second moments).
+/// use (PHYSICS.md §7: the second moments by default, the paper's convex
+/// hull on request; docs/physics-choices.md, "Reported quantities", says
+/// why).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Radii {
     /// The circle with the area of the convex hull of the contact (stick)
     /// boundary, located between cell centres
-    /// ([`APPARENT_RADIUS_DEFINITION`]).
-    #[default]
+    /// ([`APPARENT_RADIUS_DEFINITION`]): the paper's definition, its
+    /// boundary found below the cell. It jumps when a far island or a stick
+    /// cell joins the hull, so patterned ladders rarely extrapolate with
+    /// it; the configs that reproduce the paper pin it.
     Hull,
     /// From the second moment of the pressure (of μp − |q| on the stick
     /// cells) about its centroid, `r² = 5/2 ⟨r²⟩`
     /// ([`APPARENT_RADIUS_DEFINITION_MOMENTS`]): exact for Hertz and
     /// Cattaneo–Mindlin, and continuous in the solution, so that patterned
-    /// μa converges monotonically with the grid.
+    /// μa converges monotonically with the grid. The default (issue #47).
+    #[default]
     Moments,
 }
 
@@ -40,11 +43,11 @@ impl Radii {
 }
 
 /// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
-/// used for `mu_a` and `k_e`) are defined.
+/// used for `mu_a` and `k_e`) are defined under `solver.radii = "hull"`.
 pub const APPARENT_RADIUS_DEFINITION: &str = "radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres: along every row and column, the zero of p^2 ((mu p - |q|)^2 for stick) extrapolated linearly outward from the two outermost cells, kept within one cell pitch (the cell face where the level does not fall outward)";
 
 /// The second-moment definition of the apparent radii (`solver.radii =
-/// "moments"`; the default is [`APPARENT_RADIUS_DEFINITION`]).
+/// "moments"`, the default; the paper's is [`APPARENT_RADIUS_DEFINITION`]).
 pub const APPARENT_RADIUS_DEFINITION_MOMENTS: &str = "radius from the second moment about the centroid, r^2 = 5/2 <r^2>, of the pressure over the contact cells (of mu p - |q| over the stick cells): exact for a Hertz pressure and a Cattaneo-Mindlin stick zone, continuous in the solution";
 
 /// How the paper's radii (`contact_radius_cells_m`, `stick_radius_cells_m`,

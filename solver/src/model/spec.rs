@@ -80,7 +80,7 @@ impl Default for Numerics {
             max_iterations: 5000,
             coupling_tolerance: 1e-7,
             max_coupling_iterations: 50,
-            radii: Radii::Hull,
+            radii: Radii::default(),
         }
     }
 }

@@ -19,11 +19,15 @@ use crate::solve::tangential::{TangentialReport, TangentialSolution};
 /// The scalars of one solved case.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CaseScalars {
-    /// Apparent contact radius a: circle with the area of the convex hull of
-    /// the contact boundary located between cell centres
-    /// ([`crate::APPARENT_RADIUS_DEFINITION`]), m. Used for μa and K_E.
+    /// Apparent contact radius a under the case's `numerics.radii`: from
+    /// the second moment of the pressure (the default,
+    /// [`crate::APPARENT_RADIUS_DEFINITION_MOMENTS`]) or the circle with the
+    /// area of the convex hull of the contact boundary located between cell
+    /// centres ([`crate::APPARENT_RADIUS_DEFINITION`]), m. Used for μa and
+    /// K_E.
     pub contact_radius_m: f64,
-    /// Apparent stick radius c: same for the stick zone, m.
+    /// Apparent stick radius c: same for the stick zone (its level
+    /// μp − |q|), m.
     pub stick_radius_m: f64,
     /// The paper's a: circle with the area of the convex hull of the contact
     /// cells, each taken as its full square ([`crate::APPARENT_RADIUS_DEFINITION_CELLS`]), m.
@@ -171,7 +175,7 @@ fn eq19_k_e(delta_t: f64, [a, c]: [f64; 2], normal_force_n: f64, friction: f64) 
 }
 
 impl CaseScalars {
-    /// a and c ([`crate::APPARENT_RADIUS_DEFINITION`]).
+    /// a and c (under the case's `numerics.radii`).
     pub fn radii(&self) -> [f64; 2] {
         [self.contact_radius_m, self.stick_radius_m]
     }
@@ -321,10 +325,10 @@ pub(crate) fn reduce(
         && (0..len).any(|i| contact[i] && heights[i] < top);
     let hertz_radius =
         (3.0 * load * spec.load.indenter_radius_m / (4.0 * spec.contact_modulus())).cbrt();
-    // The radii of μa (`solver.radii`): by default the sub-cell hulls (p
-    // falls to zero like the root of the distance at a Hertzian edge, and
-    // μp − |q| does at a Mindlin stick edge), or the second moments of the
-    // same two levels.
+    // The radii of μa (`solver.radii`): by default the second moments of p
+    // and of μp − |q|, or the sub-cell hulls of the same two levels (p falls
+    // to zero like the root of the distance at a Hertzian edge, and μp − |q|
+    // does at a Mindlin stick edge).
     let friction = spec.load.friction;
     let radii = spec.numerics.radii;
     let a_app = apparent_radius(radii, &grid, &contact, &p, terrain);
