@@ -11,11 +11,14 @@
 
 mod dispatch;
 mod exchange;
+#[path = "../output/fretting_map.rs"]
 mod fretting_map;
 mod journal;
 mod lock;
 mod merge;
+#[path = "../output/orientation_map.rs"]
 mod orientation_map;
+#[path = "../output/sweep.rs"]
 mod output;
 mod plan;
 mod progress;
