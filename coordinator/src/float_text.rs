@@ -1,7 +1,8 @@
 //! The text of a number in every table the coordinator writes
-//! (`results.csv`, `curves.csv`, `history.csv`). Its own module so that the
-//! sweep runner and the per-case writers (`history_out`) share one format
-//! without importing each other.
+//! (`results.csv`, `curves.csv`, `history.csv`, …) and in the names the
+//! config makes (an orientation's `[1 1 1]`). A foundation below both
+//! `config` and `output` (not inside `output`, which `config` must not
+//! import): one format for both.
 
 /// Deterministic float text: shortest round-trip digits, exponent form
 /// outside [1e-3, 1e7).
@@ -11,6 +12,11 @@ pub fn fmt_f64(v: f64) -> String {
     } else {
         format!("{v:e}")
     }
+}
+
+/// The text of a number that may be missing: empty when it is.
+pub fn fmt_opt(v: Option<f64>) -> String {
+    v.map(fmt_f64).unwrap_or_default()
 }
 
 #[cfg(test)]

@@ -1,13 +1,13 @@
 //! One case in-process (no IPC), for inspection. [`solve_in_memory`] is the
 //! part shared by `mpcontact solve` and the Python module (spec, memory
 //! check, solve, flat-twin K_E, the `case.json` value); [`write_solved`] is
-//! the CLI's files (`case.json`, `.npy` fields via `npy`, PNG maps), and
+//! the CLI's files (`case.json`, `.npy` fields, PNG maps: `output`), and
 //! [`run_solve`] the CLI's whole command (with its progress line,
 //! `solve_progress`). Touches no sweep state (plan, journal, workers).
 
 use crate::case::Status;
 use crate::config::Config;
-use crate::npy::write_fields;
+use crate::output::npy::write_fields;
 use crate::solve_progress::SolveProgress;
 use anyhow::{anyhow, Context, Result};
 use serde::Serialize;
@@ -62,9 +62,9 @@ pub struct CaseJson<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     slip_regime_definition: Option<&'static str>,
     /// With `[stress]`: maxima below the surface, the surface peak and
-    /// the fatigue parameter (`crate::stress_out`).
+    /// the fatigue parameter (`crate::output::stress`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    stress: Option<&'a crate::stress_out::StressScalars>,
+    stress: Option<&'a crate::output::stress::StressScalars>,
 }
 
 /// Options of `mpcontact solve`.
@@ -184,7 +184,7 @@ pub struct Solved {
     /// Fields of the case itself.
     pub fields: Fields,
     /// With `[stress]`: the stresses below the surface.
-    pub stress: Option<crate::stress_out::StressOutput>,
+    pub stress: Option<crate::output::stress::StressOutput>,
 }
 
 impl Solved {
@@ -260,7 +260,7 @@ pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
         calibrate_on_flat(&mut scalars, &flat, &spec.load);
     }
     let stress = match &case.stress {
-        Some(cfg) => Some(crate::stress_out::compute(
+        Some(cfg) => Some(crate::output::stress::compute(
             cfg,
             spec,
             &scalars,
@@ -282,24 +282,28 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let path = out.join("case.json");
     let json = serde_json::to_string_pretty(&solved.case_json())?;
-    crate::atomic::write(&path, json.as_bytes())?;
+    crate::output::atomic::write(&path, json.as_bytes())?;
     write_fields(out, &solved.fields)?;
     // The numbers are written first; a picture that cannot be drawn (e.g. no
     // system font) is a warning, not a lost result.
     let c = &solved.case;
     let title = format!("{}, {}, ψ = {}°", c.material, c.surface, c.angle_deg);
     if let Some(h) = &solved.scalars.history {
-        for w in crate::history_out::write_history(out, h, &title)? {
+        for w in crate::output::history::write_history(out, h, &title)? {
             eprintln!("warning: {w}");
         }
     }
-    if let Err(e) =
-        crate::maps::write_maps(out, &title, &solved.fields, &solved.scalars, c.spec.grid.dx)
-    {
+    if let Err(e) = crate::output::maps::write_maps(
+        out,
+        &title,
+        &solved.fields,
+        &solved.scalars,
+        c.spec.grid.dx,
+    ) {
         eprintln!("warning: maps not written: {e:#}");
     }
     if let Some(stress) = &solved.stress {
-        for w in crate::stress_out::write(out, stress, &title)? {
+        for w in crate::output::stress::write(out, stress, &title)? {
             eprintln!("warning: {w}");
         }
     }
@@ -362,5 +366,57 @@ indenters = ["steel", "rigid"]
                 .unwrap_err()
         );
         assert!(e.contains("--indenter: unknown material `Mithril`"), "{e}");
+    }
+
+    const FE: &str = "[grid]\npoints = 64\nspacing_um = 5.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.28571\n[sweep]\nmaterials = [\"Fe\"]\nangles_deg = [0.0]\n[history]\ntangential_ratios = [0.0, 0.6, -0.6]\nsteps_per_segment = 2\n";
+
+    /// A fretting path's turning states: the frictionless start has the
+    /// Hertz von Mises peak (0.62 p_H, Hamilton), the two reversed
+    /// states mirror each other (trailing-edge tension behind the force),
+    /// and the files and keys appear only with the section.
+    #[test]
+    fn issue38_turning_states_mirror_and_outputs_only_with_the_section() {
+        let text = format!("{FE}[stress]\ndepths_um = [0.0]\nslice_rows = 16\n");
+        let c = Config::parse(&text, &[]).unwrap();
+        let solved = solve_in_memory(CaseChoice::new(&c, None, None, None).unwrap(), 1).unwrap();
+        let s = &solved.stress.as_ref().unwrap().scalars;
+        let steps: Vec<_> = s.states.iter().map(|st| st.step).collect();
+        assert_eq!(steps, vec![Some(0), Some(2), Some(4)]);
+        let start = s.states[0].max_von_mises.over_p_h;
+        assert!(
+            (start - 0.62).abs() < 0.02,
+            "frictionless von Mises {start}"
+        );
+        let (plus, minus) = (
+            s.states[1].surface_peak_along_force.unwrap(),
+            s.states[2].surface_peak_along_force.unwrap(),
+        );
+        assert!(
+            plus.at_m[0] < 0.0 && minus.at_m[0] > 0.0,
+            "{plus:?} {minus:?}"
+        );
+        assert!((plus.value_pa / minus.value_pa - 1.0).abs() < 0.01);
+        assert!(s.crossland.unwrap().value_pa > 0.0);
+        let dir = std::env::temp_dir().join(format!("mpc-stress-{}", std::process::id()));
+        write_solved(&solved, &dir).unwrap();
+        let json = std::fs::read_to_string(dir.join("case.json")).unwrap();
+        assert!(json.contains("\"stress\""));
+        for f in [
+            "plane_0um_step2_sxx.npy",
+            "slice_along_step4_von_mises.npy",
+            "slice_across_crossland.npy",
+        ] {
+            assert!(dir.join("stress").join(f).is_file(), "{f}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        let plain = Config::parse(FE, &[]).unwrap();
+        let solved =
+            solve_in_memory(CaseChoice::new(&plain, None, None, None).unwrap(), 1).unwrap();
+        assert!(solved.stress.is_none());
+        write_solved(&solved, &dir).unwrap();
+        let json = std::fs::read_to_string(dir.join("case.json")).unwrap();
+        assert!(!json.contains("\"stress\"") && !dir.join("stress").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -426,7 +426,7 @@ fn solve<'py>(
     let stress = match &solved.stress {
         Some(so) => {
             let d = PyDict::new(py);
-            for a in coordinator::stress_out::arrays(so) {
+            for a in coordinator::output::stress::arrays(so) {
                 d.set_item(
                     &a.name,
                     PyArray1::from_slice(py, &a.data).reshape([a.rows, a.cols])?,

@@ -28,7 +28,7 @@ pub use materials::{CubicCfg, IsoCfg, MaterialCfg, SweepMaterial};
 pub use orientations::{Orientation, OrientationsCfg};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};
 pub use stress::StressCfg;
-pub use surfaces::{heightmap_surface, SurfaceCfg};
+pub use surfaces::{heightmap_surface, read_grid_npy, SurfaceCfg};
 pub use sweep::{AnglesCfg, SweepCfg, MAX_ANGLES, RIGID};
 
 use crate::case::CaseKey;

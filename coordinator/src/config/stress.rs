@@ -1,9 +1,11 @@
 //! `[stress]`: stresses below the surface (issue #38), opt-in. Without the
 //! section nothing is computed and every output is as before. The
-//! computation is `solver::stress`; the files and scalars `crate::stress_out`.
+//! computation is `solver::stress`; the files and scalars
+//! `crate::output::stress`.
 
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
+use solver::stress_summary::StressRequest;
 
 /// Most depth planes (each costs a kernel of 18 padded spectra).
 pub const MAX_DEPTHS: usize = 64;
@@ -50,6 +52,19 @@ fn default_alpha() -> f64 {
 }
 
 impl StressCfg {
+    /// The solver's form of the section (what `solve`, Python and the
+    /// sweep's workers compute).
+    pub fn request(&self) -> StressRequest {
+        StressRequest {
+            depths_m: self.depths_um.iter().map(|d| d * 1e-6).collect(),
+            slices: self.slices,
+            slice_depth_m: self.slice_depth_um.map(|d| d * 1e-6),
+            slice_rows: self.slice_rows,
+            turning_states: self.states == "turning",
+            crossland_alpha: self.crossland_alpha,
+        }
+    }
+
     /// Checks the section; errors name the key.
     pub(super) fn check(&self) -> Result<()> {
         if self.depths_um.len() > MAX_DEPTHS {

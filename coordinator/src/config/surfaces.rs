@@ -1,9 +1,9 @@
 //! `[surfaces.NAME]`: custom surfaces (island lattices, stripes, height
-//! maps read from `.npy`), how a name resolves (tables first, each built
-//! once per config, then presets) and the config keys of its parameters.
+//! maps read from `.npy` by [`read_grid_npy`]), how a name resolves (tables
+//! first, each built once per config, then presets) and the config keys of
+//! its parameters.
 
 use super::{within, Config};
-use crate::npy::read_grid_npy;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use solver::{Island, LatticeKind, Sampling, Surface};
@@ -198,6 +198,53 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
     Ok(surface)
 }
 
+/// Reads an `n x n` float64 (or float32) `.npy` file in C order. Only a
+/// regular file is opened (a FIFO would block, `/dev/zero` never end), and
+/// its header is checked against the grid before any data is read, so a
+/// wrong file costs no more than its header.
+pub fn read_grid_npy(path: &Path, n: usize) -> Result<Vec<f64>> {
+    let meta =
+        std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("{} is not a regular file", path.display());
+    }
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let npy = npyz::NpyFile::new(std::io::BufReader::new(file))
+        .with_context(|| format!("{} is not a .npy file", path.display()))?;
+    let shape = npy.shape().to_vec();
+    if shape != [n as u64, n as u64] {
+        bail!(
+            "{} has shape {shape:?} but the grid is {n} x {n} (grid.points)",
+            path.display()
+        );
+    }
+    if npy.order() != npyz::Order::C {
+        bail!("Fortran-ordered arrays are not supported; save with numpy's default C order");
+    }
+    let size = match npy.dtype() {
+        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float => t.size_field(),
+        other => bail!(
+            "{}: expected float64 or float32 values, got {}",
+            path.display(),
+            other.descr()
+        ),
+    };
+    if meta.len() < (n * n) as u64 * size {
+        bail!(
+            "{} is {} bytes, too short for {n} x {n} values",
+            path.display(),
+            meta.len()
+        );
+    }
+    let values: Vec<f64> = if size == 4 {
+        npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
+    } else {
+        npy.into_vec::<f64>()?
+    };
+    Ok(values)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::fixtures::{err, BASE};
@@ -277,7 +324,7 @@ mod tests {
         let tmp_dir = tempfile::tempdir().unwrap();
         let dir = tmp_dir.path().to_path_buf();
         let heights = vec![0.0; 64 * 64];
-        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        crate::output::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
         let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
             .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
         let c = Config::parse_in(&text, &[], &dir).unwrap();
@@ -319,8 +366,8 @@ mod tests {
         let heights: Vec<f64> = (0..64 * 64)
             .map(|i| if i % 7 == 0 { 0.5 } else { 0.0 })
             .collect();
-        crate::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
-        crate::npy::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
+        crate::output::npy::write_npy(&dir.join("h.npy"), 64, &heights).unwrap();
+        crate::output::npy::write_npy(&dir.join("small.npy"), 32, &heights[..32 * 32]).unwrap();
         let text = format!("{BASE}\n[surfaces.rough]\nshape = \"heightmap\"\nfile = \"h.npy\"\n")
             .replace("surfaces = [\"flat\"]", "surfaces = [\"rough\"]");
         let c = Config::parse_in(&text, &[], &dir).unwrap();

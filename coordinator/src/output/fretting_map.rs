@@ -11,8 +11,9 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::output::Row;
-use crate::float_text::fmt_f64;
+use super::plot::{self, err, Area, Figure, Frame, Panels, PALETTE};
+use super::sweep::{csv_field as cell, Row};
+use crate::float_text::{fmt_f64, fmt_opt as opt};
 
 /// Header of `fretting_map.csv` (`indenter` after `surface` in a sweep over
 /// balls).
@@ -56,9 +57,9 @@ pub struct MapPoint {
 pub fn map_points(rows: &[Row]) -> Vec<MapPoint> {
     let mut v: Vec<MapPoint> = rows
         .iter()
-        .filter(|r| r.case.key.level == 0)
+        .filter(|r| r.key.level == 0)
         .filter_map(|r| {
-            let key = &r.case.key;
+            let key = r.key;
             let amplitude_um = key.amplitude_um?;
             let h = r.scalars.as_ref().and_then(|s| s.history.as_ref());
             Some(MapPoint {
@@ -66,9 +67,9 @@ pub fn map_points(rows: &[Row]) -> Vec<MapPoint> {
                 surface: key.surface.clone(),
                 indenter: key.indenter.clone(),
                 angle_deg: key.angle_deg,
-                normal_n: r.case.spec.load.normal_force_n,
+                normal_n: r.spec.load.normal_force_n,
                 amplitude_um,
-                status: r.record.status.to_string(),
+                status: r.status.to_string(),
                 regime: h.and_then(|h| h.regime.clone()),
                 dissipated_j: h.and_then(|h| h.dissipated_energy_per_cycle_j),
                 energy_ratio: h.and_then(|h| h.energy_ratio),
@@ -85,18 +86,6 @@ pub fn map_points(rows: &[Row]) -> Vec<MapPoint> {
             .then(a.amplitude_um.total_cmp(&b.amplitude_um))
     });
     v
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map(fmt_f64).unwrap_or_default()
-}
-
-fn cell(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 fn header(h: &str, balls: bool) -> String {
@@ -262,9 +251,9 @@ pub fn transitions_csv(points: &[MapPoint]) -> String {
 /// Marker colour of a regime.
 fn regime_colour(regime: Option<&str>) -> RGBColor {
     match regime {
-        Some("partial") => RGBColor(31, 119, 180),
-        Some("gross") => RGBColor(214, 39, 40),
-        Some("mixed") => RGBColor(255, 127, 14),
+        Some("partial") => PALETTE[0],
+        Some("gross") => PALETTE[1],
+        Some("mixed") => PALETTE[3],
         _ => RGBColor(150, 150, 150),
     }
 }
@@ -313,186 +302,172 @@ pub fn plot_map(path: &Path, points: &[MapPoint]) -> anyhow::Result<()> {
         v.dedup();
         v.len()
     };
-    let cols = panels.len().clamp(1, 2);
-    let rows = panels.len().div_ceil(2).max(1);
-    let size = (560 * cols as u32 + 140, 400 * rows as u32);
-    let is_svg = path.extension().is_some_and(|e| e == "svg");
-    crate::atomic::replace_with(path, |tmp| {
-        if is_svg {
-            draw(
-                SVGBackend::new(tmp, size).into_drawing_area(),
-                &panels,
-                cols,
-                loads > 1,
-            )
-        } else {
-            draw(
-                BitMapBackend::new(tmp, size).into_drawing_area(),
-                &panels,
-                cols,
-                loads > 1,
-            )
-        }
-    })
+    let layout = Panels {
+        count: panels.len(),
+        legend: 140,
+    };
+    let figure = MapFigure {
+        panels,
+        layout,
+        by_load: loads > 1,
+    };
+    plot::write(path, figure.layout.size(), &figure)
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    panels: &[MapPanel],
-    cols: usize,
+/// The map as drawn: its panels in their grid beside the legend; y the
+/// normal load (`by_load`, several loads) or the energy per cycle.
+struct MapFigure<'a> {
+    panels: Vec<MapPanel<'a>>,
+    layout: Panels,
     by_load: bool,
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(e)?;
-    let (plot_area, legend) = root.split_horizontally(root.dim_in_pixel().0 - 140);
-    let rows = panels.len().div_ceil(cols).max(1);
-    let areas = plot_area.split_evenly((rows, cols));
-    let y_of = |p: &MapPoint| -> Option<f64> {
-        if by_load {
-            Some(p.normal_n)
-        } else {
-            p.dissipated_j.map(|w| w * 1e3)
-        }
-    };
-    for (panel, area) in panels.iter().zip(areas.iter()) {
-        let xs = panel.points.iter().map(|p| p.amplitude_um);
-        let (xlo, xhi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x), b.max(x))
-        });
-        let ys: Vec<f64> = panel.points.iter().filter_map(|p| y_of(p)).collect();
-        let (mut ylo, mut yhi) = ys
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
-                (a.min(y), b.max(y))
-            });
-        if !ylo.is_finite() {
-            (ylo, yhi) = (0.0, 1.0);
-        }
-        if by_load {
-            let pad = ((yhi - ylo) * 0.1).max(0.1 * yhi.abs().max(1.0));
-            (ylo, yhi) = (ylo - pad, yhi + pad);
-        } else {
-            (ylo, yhi) = (0.0, yhi.max(1e-12) * 1.1);
-        }
-        let (xlo, xhi) = if xlo.is_finite() {
-            let pad = ((xhi - xlo) * 0.05).max(0.05 * xhi.abs().max(1e-3));
-            (xlo - pad, xhi + pad)
-        } else {
-            (0.0, 1.0)
-        };
-        let mut chart = ChartBuilder::on(area)
-            .caption(&panel.title, ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(xlo..xhi, ylo..yhi)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("displacement amplitude Δ (µm)")
-            .y_desc(if by_load {
-                "normal load P (N)"
+}
+
+impl Figure for MapFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> anyhow::Result<()> {
+        let (panels, by_load) = (&self.panels, self.by_load);
+        let (areas, legend) = self.layout.split(root);
+        let y_of = |p: &MapPoint| -> Option<f64> {
+            if by_load {
+                Some(p.normal_n)
             } else {
-                "energy per cycle (mJ)"
-            })
-            .y_label_formatter(&|y| {
-                if by_load {
-                    format!("{y:.0}")
-                } else {
-                    format!("{y:.1}")
-                }
-            })
-            .x_label_formatter(&|x| format!("{x}"))
-            .draw()
-            .map_err(e)?;
-        if !by_load {
-            let mut line: Vec<(f64, f64)> = panel
-                .points
+                p.dissipated_j.map(|w| w * 1e3)
+            }
+        };
+        for (panel, area) in panels.iter().zip(areas.iter()) {
+            let xs = panel.points.iter().map(|p| p.amplitude_um);
+            let (xlo, xhi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+            let ys: Vec<f64> = panel.points.iter().filter_map(|p| y_of(p)).collect();
+            let (mut ylo, mut yhi) = ys
                 .iter()
-                .filter_map(|p| Some((p.amplitude_um, y_of(p)?)))
-                .collect();
-            line.sort_by(|a, b| a.0.total_cmp(&b.0));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+                    (a.min(y), b.max(y))
+                });
+            if !ylo.is_finite() {
+                (ylo, yhi) = (0.0, 1.0);
+            }
+            if by_load {
+                let pad = ((yhi - ylo) * 0.1).max(0.1 * yhi.abs().max(1.0));
+                (ylo, yhi) = (ylo - pad, yhi + pad);
+            } else {
+                (ylo, yhi) = (0.0, yhi.max(1e-12) * 1.1);
+            }
+            let (xlo, xhi) = if xlo.is_finite() {
+                let pad = ((xhi - xlo) * 0.05).max(0.05 * xhi.abs().max(1e-3));
+                (xlo - pad, xhi + pad)
+            } else {
+                (0.0, 1.0)
+            };
+            let frame = Frame {
+                title: 20,
+                margin: 10,
+                labels: (40, 70),
+            };
+            let mut chart = frame.chart(area, &panel.title, xlo..xhi, ylo..yhi)?;
             chart
-                .draw_series(LineSeries::new(
-                    line,
-                    RGBColor(160, 160, 160).stroke_width(1),
-                ))
-                .map_err(e)?;
-        }
-        chart
-            .draw_series(panel.points.iter().filter_map(|p| {
-                let y = y_of(p)?;
-                let c = regime_colour(p.regime.as_deref());
-                Some(Circle::new((p.amplitude_um, y), 6, c.filled()))
-            }))
-            .map_err(e)?;
-        // The transition: a dashed vertical line with one load, the
-        // transition line through the loads with several.
-        let black = BLACK.stroke_width(2);
-        if by_load {
-            let mut t = panel.transitions.clone();
-            t.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let line: Vec<(f64, f64)> = t.iter().map(|&(p, a)| (a, p)).collect();
-            chart
-                .draw_series(LineSeries::new(line.clone(), black))
-                .map_err(e)?;
-            chart
-                .draw_series(line.iter().map(|&c| Cross::new(c, 6, black)))
-                .map_err(e)?;
-        } else {
-            for &(_, a) in &panel.transitions {
+                .configure_mesh()
+                .x_desc("displacement amplitude Δ (µm)")
+                .y_desc(if by_load {
+                    "normal load P (N)"
+                } else {
+                    "energy per cycle (mJ)"
+                })
+                .y_label_formatter(&|y| {
+                    if by_load {
+                        format!("{y:.0}")
+                    } else {
+                        format!("{y:.1}")
+                    }
+                })
+                .x_label_formatter(&|x| format!("{x}"))
+                .draw()
+                .map_err(err)?;
+            if !by_load {
+                let mut line: Vec<(f64, f64)> = panel
+                    .points
+                    .iter()
+                    .filter_map(|p| Some((p.amplitude_um, y_of(p)?)))
+                    .collect();
+                line.sort_by(|a, b| a.0.total_cmp(&b.0));
                 chart
-                    .draw_series(DashedLineSeries::new([(a, ylo), (a, yhi)], 6, 4, black))
-                    .map_err(e)?;
+                    .draw_series(LineSeries::new(
+                        line,
+                        RGBColor(160, 160, 160).stroke_width(1),
+                    ))
+                    .map_err(err)?;
+            }
+            chart
+                .draw_series(panel.points.iter().filter_map(|p| {
+                    let y = y_of(p)?;
+                    let c = regime_colour(p.regime.as_deref());
+                    Some(Circle::new((p.amplitude_um, y), 6, c.filled()))
+                }))
+                .map_err(err)?;
+            // The transition: a dashed vertical line with one load, the
+            // transition line through the loads with several.
+            let black = BLACK.stroke_width(2);
+            if by_load {
+                let mut t = panel.transitions.clone();
+                t.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let line: Vec<(f64, f64)> = t.iter().map(|&(p, a)| (a, p)).collect();
                 chart
-                    .draw_series([Text::new(
-                        format!(" transition {a:.2} µm"),
-                        (a, yhi),
-                        ("sans-serif", 14).into_font(),
-                    )])
-                    .map_err(e)?;
+                    .draw_series(LineSeries::new(line.clone(), black))
+                    .map_err(err)?;
+                chart
+                    .draw_series(line.iter().map(|&c| Cross::new(c, 6, black)))
+                    .map_err(err)?;
+            } else {
+                for &(_, a) in &panel.transitions {
+                    chart
+                        .draw_series(DashedLineSeries::new([(a, ylo), (a, yhi)], 6, 4, black))
+                        .map_err(err)?;
+                    chart
+                        .draw_series([Text::new(
+                            format!(" transition {a:.2} µm"),
+                            (a, yhi),
+                            ("sans-serif", 14).into_font(),
+                        )])
+                        .map_err(err)?;
+                }
             }
         }
-    }
-    // Legend: the regimes and the transition.
-    let items: [(&str, Option<&str>); 4] = [
-        ("partial slip", Some("partial")),
-        ("gross slip", Some("gross")),
-        ("mixed", Some("mixed")),
-        ("no result", None),
-    ];
-    for (k, (label, regime)) in items.iter().enumerate() {
-        let y = 40 + 26 * k as i32;
+        // Legend: the regimes and the transition.
+        let items: [(&str, Option<&str>); 4] = [
+            ("partial slip", Some("partial")),
+            ("gross slip", Some("gross")),
+            ("mixed", Some("mixed")),
+            ("no result", None),
+        ];
+        for (k, (label, regime)) in items.iter().enumerate() {
+            let y = 40 + 26 * k as i32;
+            legend
+                .draw(&Circle::new((14, y), 6, regime_colour(*regime).filled()))
+                .map_err(err)?;
+            legend
+                .draw(&Text::new(
+                    *label,
+                    (28, y - 8),
+                    ("sans-serif", 15).into_font(),
+                ))
+                .map_err(err)?;
+        }
+        let y = 40 + 26 * 4;
         legend
-            .draw(&Circle::new((14, y), 6, regime_colour(*regime).filled()))
-            .map_err(e)?;
+            .draw(&PathElement::new(
+                vec![(6, y), (22, y)],
+                BLACK.stroke_width(2),
+            ))
+            .map_err(err)?;
         legend
             .draw(&Text::new(
-                *label,
+                "transition",
                 (28, y - 8),
                 ("sans-serif", 15).into_font(),
             ))
-            .map_err(e)?;
+            .map_err(err)?;
+        Ok(())
     }
-    let y = 40 + 26 * 4;
-    legend
-        .draw(&PathElement::new(
-            vec![(6, y), (22, y)],
-            BLACK.stroke_width(2),
-        ))
-        .map_err(e)?;
-    legend
-        .draw(&Text::new(
-            "transition",
-            (28, y - 8),
-            ("sans-serif", 15).into_font(),
-        ))
-        .map_err(e)?;
-    root.present().map_err(e)?;
-    Ok(())
 }
 
 #[cfg(test)]

@@ -10,6 +10,8 @@ use solver::HistoryOutput;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::plot::{self, err, Area, Figure, Frame, PALETTE};
+
 /// Header of `history.csv`.
 pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged";
 
@@ -67,99 +69,82 @@ fn loop_lines(h: &HistoryOutput) -> Vec<(String, Vec<(f64, f64)>)> {
     lines
 }
 
+/// The hysteresis loop as drawn: its lines and title.
+struct Hysteresis<'a> {
+    lines: Vec<(String, Vec<(f64, f64)>)>,
+    title: &'a str,
+}
+
 /// Draws the hysteresis loop to `path` (PNG or SVG by extension).
 pub fn plot_hysteresis(path: &Path, h: &HistoryOutput, title: &str) -> Result<()> {
     let lines = loop_lines(h);
-    let size = (760, 520);
-    let is_svg = path.extension().is_some_and(|e| e == "svg");
-    crate::atomic::replace_with(path, |tmp| {
-        if is_svg {
-            draw(
-                SVGBackend::new(tmp, size).into_drawing_area(),
-                &lines,
-                title,
-            )
-        } else {
-            draw(
-                BitMapBackend::new(tmp, size).into_drawing_area(),
-                &lines,
-                title,
-            )
-        }
-    })
+    plot::write(path, (760, 520), &Hysteresis { lines, title })
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    lines: &[(String, Vec<(f64, f64)>)],
-    title: &str,
-) -> Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(e)?;
-    let pts = lines.iter().flat_map(|(_, l)| l.iter());
-    let (mut xlo, mut xhi, mut ylo, mut yhi) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in pts {
-        xlo = xlo.min(x);
-        xhi = xhi.max(x);
-        ylo = ylo.min(y);
-        yhi = yhi.max(y);
-    }
-    if !xlo.is_finite() || xhi <= xlo || yhi <= ylo {
-        (xlo, xhi, ylo, yhi) = (-1.0, 1.0, -1.0, 1.0);
-    }
-    let (xp, yp) = ((xhi - xlo) * 0.05, (yhi - ylo) * 0.05);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((xlo - xp)..(xhi + xp), (ylo - yp)..(yhi + yp))
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .x_desc("tangential shift δt along the force (μm)")
-        .y_desc("tangential force F (N)")
-        .draw()
-        .map_err(e)?;
-    const COLOURS: [(u8, u8, u8); 6] = [
-        (0, 0, 0),
-        (31, 119, 180),
-        (214, 39, 40),
-        (44, 160, 44),
-        (255, 127, 14),
-        (148, 103, 189),
-    ];
-    for (k, (label, line)) in lines.iter().enumerate() {
-        let (r, g, b) = COLOURS[k % COLOURS.len()];
-        let colour = RGBColor(r, g, b);
+impl Figure for Hysteresis<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
+        let lines = &self.lines;
+        let pts = lines.iter().flat_map(|(_, l)| l.iter());
+        let (mut xlo, mut xhi, mut ylo, mut yhi) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y) in pts {
+            xlo = xlo.min(x);
+            xhi = xhi.max(x);
+            ylo = ylo.min(y);
+            yhi = yhi.max(y);
+        }
+        if !xlo.is_finite() || xhi <= xlo || yhi <= ylo {
+            (xlo, xhi, ylo, yhi) = (-1.0, 1.0, -1.0, 1.0);
+        }
+        let (xp, yp) = ((xhi - xlo) * 0.05, (yhi - ylo) * 0.05);
+        let frame = Frame {
+            title: 20,
+            margin: 12,
+            labels: (44, 64),
+        };
+        let mut chart = frame.chart(
+            root,
+            self.title,
+            (xlo - xp)..(xhi + xp),
+            (ylo - yp)..(yhi + yp),
+        )?;
         chart
-            .draw_series(LineSeries::new(
-                line.iter().copied(),
-                colour.stroke_width(2),
-            ))
-            .map_err(e)?
-            .label(label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+            .configure_mesh()
+            .x_desc("tangential shift δt along the force (μm)")
+            .y_desc("tangential force F (N)")
+            .draw()
+            .map_err(err)?;
+        for (k, (label, line)) in lines.iter().enumerate() {
+            // The first loading black, then the cycles in the palette's
+            // first five colours, and again.
+            let colour = match k % 6 {
+                0 => BLACK,
+                c => PALETTE[c - 1],
+            };
+            chart
+                .draw_series(LineSeries::new(
+                    line.iter().copied(),
+                    colour.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+        Ok(())
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()
-        .map_err(e)?;
-    root.present().map_err(e)?;
-    Ok(())
 }
 
 /// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`.
@@ -167,7 +152,7 @@ where
 /// as a warning, not an error.
 pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir)?;
-    crate::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
+    super::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
     let mut warnings = Vec::new();
     for name in ["hysteresis.png", "hysteresis.svg"] {
         if let Err(e) = plot_hysteresis(&dir.join(name), h, title) {

@@ -1,33 +1,21 @@
 //! PNG contour maps of one case's surface fields, in the paper's style
 //! (Figs. 4, 5, 7, 8): p/p_H, qx/p_H, qy/p_H, slip magnitude and the
-//! stick/slip map, axes in units of the contact radius, with a colour bar.
-//! Drawing only; the fields come from `solver::Fields`.
+//! stick/slip map, axes in units of the contact radius, with a colour bar;
+//! and [`Heat`], a rectangular map with marks (the stress planes and
+//! slices). Drawing only (through `plot`); the fields come from
+//! `solver::Fields`.
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use plotters::prelude::*;
 use solver::{CaseScalars, Fields};
 use std::path::Path;
 
-/// Colour of `t ∈ [0, 1]` on a perceptually ordered ramp (dark blue → yellow).
-pub(crate) fn ramp(t: f64) -> RGBColor {
-    let stops = [
-        (0.0, (48, 18, 59)),
-        (0.25, (40, 120, 230)),
-        (0.5, (30, 200, 160)),
-        (0.75, (240, 200, 40)),
-        (1.0, (180, 20, 10)),
-    ];
-    let t = t.clamp(0.0, 1.0);
-    for w in stops.windows(2) {
-        let ((t0, c0), (t1, c1)) = (w[0], w[1]);
-        if t <= t1 {
-            let u = (t - t0) / (t1 - t0);
-            let mix = |a: u8, b: u8| (a as f64 + u * (b as f64 - a as f64)).round() as u8;
-            return RGBColor(mix(c0.0, c1.0), mix(c0.1, c1.1), mix(c0.2, c1.2));
-        }
-    }
-    RGBColor(180, 20, 10)
-}
+use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame};
+
+/// The size of a map (PNG).
+const SIZE: (u32, u32) = (760, 640);
+/// The width of the map; its colour bar takes the rest.
+const MAP_WIDTH: u32 = 620;
 
 /// One map: `values` (n x n, row-major [iy][ix]) drawn over |x|, |y| ≤ extent·a.
 struct Map<'a> {
@@ -37,101 +25,82 @@ struct Map<'a> {
 }
 
 /// The colour bar beside a map: the ramp from `lo` to `hi` under `label`.
-fn colour_bar(
-    bar: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
-    label: &str,
-    lo: f64,
-    hi: f64,
-) -> Result<()> {
-    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
-    let mut cb = ChartBuilder::on(bar)
-        .caption(label, ("sans-serif", 14))
-        .margin_top(12)
-        .margin_bottom(50)
-        .margin_left(8)
-        .margin_right(8)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(|e| err(&e))?;
-    cb.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| format!("{v:.3}"))
-        .draw()
-        .map_err(|e| err(&e))?;
-    let steps = 200;
-    cb.draw_series((0..steps).map(|k| {
-        let (v0, v1) = (
-            lo + (hi - lo) * k as f64 / steps as f64,
-            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
-        );
-        Rectangle::new(
-            [(0.0, v0), (1.0, v1)],
-            ramp((k as f64 + 0.5) / steps as f64).filled(),
-        )
-    }))
-    .map_err(|e| err(&e))?;
-    Ok(())
+fn colour_bar<DB: DrawingBackend>(bar: &Area<DB>, label: &str, lo: f64, hi: f64) -> Result<()> {
+    ColourBar {
+        label,
+        title: 14,
+        margins: [12, 50, 8, 8],
+        ticks: 13,
+        decimals: 3,
+        steps: 200,
+    }
+    .draw(bar, lo, hi)
 }
 
-fn draw_map(
-    path: &Path,
-    title: &str,
-    map: &Map,
+/// A [`Map`] of a case as drawn: its title, the grid (n cells of dx), the
+/// contact radius a and the extent of the axes in units of a.
+struct MapFigure<'a> {
+    title: &'a str,
+    map: &'a Map<'a>,
     n: usize,
     dx: f64,
     a: f64,
     extent: f64,
-) -> Result<()> {
-    let root = BitMapBackend::new(path, (760, 640)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (main, bar) = root.split_horizontally(620);
-    let half = 0.5 * (n as f64 - 1.0);
-    let to_x = |i: usize| (i as f64 - half) * dx / a;
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let inside = |i: usize| to_x(i).abs() <= extent;
-    for iy in (0..n).filter(|&i| inside(i)) {
-        for ix in (0..n).filter(|&i| inside(i)) {
-            let v = map.values[iy * n + ix];
-            if v.is_finite() {
-                lo = lo.min(v);
-                hi = hi.max(v);
+}
+
+impl Figure for MapFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
+        let &MapFigure {
+            title,
+            map,
+            n,
+            dx,
+            a,
+            extent,
+        } = self;
+        let (main, bar) = root.split_horizontally(MAP_WIDTH);
+        let half = 0.5 * (n as f64 - 1.0);
+        let to_x = |i: usize| (i as f64 - half) * dx / a;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let inside = |i: usize| to_x(i).abs() <= extent;
+        for iy in (0..n).filter(|&i| inside(i)) {
+            for ix in (0..n).filter(|&i| inside(i)) {
+                let v = map.values[iy * n + ix];
+                if v.is_finite() {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
             }
         }
+        if !(lo.is_finite() && hi > lo) {
+            (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
+        }
+        let frame = Frame {
+            title: 18,
+            margin: 10,
+            labels: (40, 50),
+        };
+        let mut chart = frame.chart(&main, title, -extent..extent, -extent..extent)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("x / a")
+            .y_desc("y / a")
+            .draw()
+            .map_err(err)?;
+        let h = 0.5 * dx / a;
+        chart
+            .draw_series((0..n).filter(|&i| inside(i)).flat_map(|iy| {
+                let values = &map.values;
+                (0..n).filter(move |&i| inside(i)).map(move |ix| {
+                    let (x, y) = (to_x(ix), to_x(iy));
+                    let t = (values[iy * n + ix] - lo) / (hi - lo);
+                    Rectangle::new([(x - h, y - h), (x + h, y + h)], ramp(t).filled())
+                })
+            }))
+            .map_err(err)?;
+        colour_bar(&bar, map.label, lo, hi)
     }
-    if !(lo.is_finite() && hi > lo) {
-        (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
-    }
-    let mut chart = ChartBuilder::on(&main)
-        .caption(title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(-extent..extent, -extent..extent)
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x / a")
-        .y_desc("y / a")
-        .draw()
-        .map_err(|e| err(&e))?;
-    let h = 0.5 * dx / a;
-    chart
-        .draw_series((0..n).filter(|&i| inside(i)).flat_map(|iy| {
-            let values = &map.values;
-            (0..n).filter(move |&i| inside(i)).map(move |ix| {
-                let (x, y) = (to_x(ix), to_x(iy));
-                let t = (values[iy * n + ix] - lo) / (hi - lo);
-                Rectangle::new([(x - h, y - h), (x + h, y + h)], ramp(t).filled())
-            })
-        }))
-        .map_err(|e| err(&e))?;
-    colour_bar(&bar, map.label, lo, hi)?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
 }
 
 /// Writes `p.png`, `qx.png`, `qy.png`, `slip.png` and `stick.png` into `dir`.
@@ -197,16 +166,22 @@ pub fn write_maps(
     for m in &maps {
         let path = dir.join(m.file);
         let label = format!("{title}: {}", m.label);
-        crate::atomic::replace_with(&path, |tmp| {
-            draw_map(tmp, &label, m, n, spacing_m, a, extent)
-        })?;
+        let figure = MapFigure {
+            title: &label,
+            map: m,
+            n,
+            dx: spacing_m,
+            a,
+            extent,
+        };
+        plot::write(&path, SIZE, &figure)?;
     }
     Ok(())
 }
 
 /// A rectangular map of `values` (`rows x cols`, row major, row 0 at
 /// `y_range.0`) over `x_range x y_range` (cell centres at the ends), with
-/// black marks at `marks`: the stress planes and slices (`stress_out`),
+/// black marks at `marks`: the stress planes and slices (`output::stress`),
 /// where the marks are the contact edge.
 pub struct Heat<'a> {
     /// Title above the map.
@@ -231,69 +206,66 @@ pub struct Heat<'a> {
 
 /// Draws a [`Heat`] map into `path` (PNG, written whole or not at all).
 pub fn write_heat(path: &Path, heat: &Heat) -> Result<()> {
-    crate::atomic::replace_with(path, |tmp| draw_heat(tmp, heat))
+    plot::write(path, SIZE, heat)
 }
 
-fn draw_heat(path: &Path, m: &Heat) -> Result<()> {
-    let root = BitMapBackend::new(path, (760, 640)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Debug| anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (main, bar) = root.split_horizontally(620);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in m.values.iter().filter(|v| v.is_finite()) {
-        lo = lo.min(*v);
-        hi = hi.max(*v);
-    }
-    if !(lo.is_finite() && hi > lo) {
-        (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
-    }
-    let step = |r: (f64, f64), k: usize| {
-        if k > 1 {
-            (r.1 - r.0) / (k - 1) as f64
-        } else {
-            1.0
+impl Figure for Heat<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
+        let m = self;
+        let (main, bar) = root.split_horizontally(MAP_WIDTH);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in m.values.iter().filter(|v| v.is_finite()) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
         }
-    };
-    let (hx, hy) = (0.5 * step(m.x_range, m.cols), 0.5 * step(m.y_range, m.rows));
-    let (x0, x1) = (m.x_range.0 - hx, m.x_range.1 + hx);
-    let (ya, yb) = (m.y_range.0 - hy, m.y_range.1 + hy);
-    let (y0, y1) = (ya.min(yb), ya.max(yb));
-    let mut chart = ChartBuilder::on(&main)
-        .caption(m.title, ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(m.axes.0)
-        .y_desc(m.axes.1)
-        .draw()
-        .map_err(|e| err(&e))?;
-    let (dx, dy) = (2.0 * hx, 2.0 * hy);
-    chart
-        .draw_series((0..m.rows).flat_map(|r| {
-            (0..m.cols).map(move |c| {
-                let x = m.x_range.0 + c as f64 * dx;
-                let y = m.y_range.0 + r as f64 * dy;
-                let t = (m.values[r * m.cols + c] - lo) / (hi - lo);
-                Rectangle::new(
-                    [(x - hx, y - hy.abs()), (x + hx, y + hy.abs())],
-                    ramp(t).filled(),
-                )
-            })
-        }))
-        .map_err(|e| err(&e))?;
-    chart
-        .draw_series(
-            m.marks
-                .iter()
-                .map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())),
-        )
-        .map_err(|e| err(&e))?;
-    colour_bar(&bar, m.label, lo, hi)?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+        if !(lo.is_finite() && hi > lo) {
+            (lo, hi) = (lo.min(0.0), lo.max(0.0) + 1.0);
+        }
+        let step = |r: (f64, f64), k: usize| {
+            if k > 1 {
+                (r.1 - r.0) / (k - 1) as f64
+            } else {
+                1.0
+            }
+        };
+        let (hx, hy) = (0.5 * step(m.x_range, m.cols), 0.5 * step(m.y_range, m.rows));
+        let (x0, x1) = (m.x_range.0 - hx, m.x_range.1 + hx);
+        let (ya, yb) = (m.y_range.0 - hy, m.y_range.1 + hy);
+        let (y0, y1) = (ya.min(yb), ya.max(yb));
+        let frame = Frame {
+            title: 16,
+            margin: 10,
+            labels: (40, 50),
+        };
+        let mut chart = frame.chart(&main, m.title, x0..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(m.axes.0)
+            .y_desc(m.axes.1)
+            .draw()
+            .map_err(err)?;
+        let (dx, dy) = (2.0 * hx, 2.0 * hy);
+        chart
+            .draw_series((0..m.rows).flat_map(|r| {
+                (0..m.cols).map(move |c| {
+                    let x = m.x_range.0 + c as f64 * dx;
+                    let y = m.y_range.0 + r as f64 * dy;
+                    let t = (m.values[r * m.cols + c] - lo) / (hi - lo);
+                    Rectangle::new(
+                        [(x - hx, y - hy.abs()), (x + hx, y + hy.abs())],
+                        ramp(t).filled(),
+                    )
+                })
+            }))
+            .map_err(err)?;
+        chart
+            .draw_series(
+                m.marks
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())),
+            )
+            .map_err(err)?;
+        colour_bar(&bar, m.label, lo, hi)
+    }
 }

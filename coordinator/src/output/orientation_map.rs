@@ -13,11 +13,12 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use plotters::prelude::*;
 
-use super::output::{csv_field, CurvePoint, Row};
+use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame};
+use super::sweep::{csv_field, Axes, CurvePoint, Row};
 use crate::case::CaseKey;
 use crate::config::orientations::{ipf_xy, miller_text};
 use crate::config::Orientation;
-use crate::float_text::fmt_f64;
+use crate::float_text::{fmt_f64, fmt_opt as opt};
 
 /// Header of `orientations.csv` (`indenter`, `normal_n`, `amplitude_um`
 /// after `surface` as in the other CSVs of a sweep with those axes).
@@ -76,17 +77,17 @@ pub fn orientation_rows(
     let mut contacts: BTreeMap<ContactKey, solver::indentation::WillisContact> = BTreeMap::new();
     let mut out: Vec<OrientationRow> = Vec::new();
     let mut index: BTreeMap<String, usize> = BTreeMap::new();
-    for r in rows.iter().filter(|r| r.case.key.level == 0) {
-        let Some(o) = by_name.get(r.case.key.material.as_str()) else {
+    for r in rows.iter().filter(|r| r.key.level == 0) {
+        let Some(o) = by_name.get(r.key.material.as_str()) else {
             continue;
         };
-        let mut key = r.case.key.point();
+        let mut key = r.key.point();
         key.angle_deg = 0.0;
         let text = key.to_string();
         if index.contains_key(&text) {
             continue;
         }
-        let spec = &r.case.spec;
+        let spec = r.spec;
         let means = *crystal
             .entry(o.name.clone())
             .or_insert_with(|| solver::indentation::InPlaneMeans::of(&spec.material));
@@ -165,13 +166,13 @@ pub fn orientation_rows(
 
 /// Text of `orientations.csv`.
 pub fn orientations_csv(rows: &[OrientationRow]) -> String {
-    let axes = super::output::Axes::of(rows.iter().map(|r| &r.key));
+    let axes = Axes::of(rows.iter().map(|r| &r.key));
     let mut out = String::from(ORIENTATIONS_HEADER);
     let mut extra = String::new();
     for (on, name) in [
-        (axes.balls, super::output::INDENTER_COLUMN),
-        (axes.loads, super::output::NORMAL_COLUMN),
-        (axes.amplitudes, super::output::AMPLITUDE_COLUMN),
+        (axes.balls, super::sweep::INDENTER_COLUMN),
+        (axes.loads, super::sweep::NORMAL_COLUMN),
+        (axes.amplitudes, super::sweep::AMPLITUDE_COLUMN),
     ] {
         if on {
             extra.push(',');
@@ -180,7 +181,6 @@ pub fn orientations_csv(rows: &[OrientationRow]) -> String {
     }
     out = out.replacen(",surface,", &format!(",surface{extra},"), 1);
     out.push('\n');
-    let opt = |v: Option<f64>| v.map(fmt_f64).unwrap_or_default();
     let triple = |v: Option<(f64, f64, f64)>| {
         let (a, b, c) = match v {
             Some((a, b, c)) => (Some(a), Some(b), Some(c)),
@@ -468,143 +468,112 @@ pub fn write_ipf(dir: &Path, map: &IpfMap) -> anyhow::Result<()> {
         std::fs::create_dir_all(parent)?;
     }
     for ext in ["png", "svg"] {
-        let path = base.with_extension(ext);
-        let size = (640u32, 520u32);
-        crate::atomic::replace_with(&path, |tmp| {
-            if ext == "svg" {
-                draw(SVGBackend::new(tmp, size).into_drawing_area(), map)
-            } else {
-                draw(BitMapBackend::new(tmp, size).into_drawing_area(), map)
-            }
-        })?;
+        plot::write(&base.with_extension(ext), (640, 520), map)?;
     }
     Ok(())
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    map: &IpfMap,
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(e)?;
-    let (main, bar) = root.split_horizontally(520);
-    // Reduced to the triangle (the cubic symmetry), as unit vectors.
-    let pts: Vec<(Vector3<f64>, f64)> = map
-        .points
-        .iter()
-        .map(|(n, v)| {
-            let (x, y) = ipf_xy(*n);
-            (unit_of(x, y), *v)
-        })
-        .collect();
-    let (lo, hi) = pts
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.1), b.max(p.1))
-        });
-    let (lo, hi) = if hi > lo {
-        (lo, hi)
-    } else {
-        (lo - 0.5, lo + 0.5)
-    };
-    let xmax = (0.5_f64).sqrt() / (1.0 + 0.5_f64.sqrt());
-    let ymax = (1.0 / 3.0_f64.sqrt()) / (1.0 + 1.0 / 3.0_f64.sqrt());
-    let mut chart = ChartBuilder::on(&main)
-        .caption(&map.title, ("sans-serif", 15))
-        .margin(20)
-        .build_cartesian_2d(-0.03..xmax + 0.03, -0.05..ymax + 0.06)
-        .map_err(e)?;
-    // Fill: cells of the projected plane inside the triangle.
-    let cols = 110;
-    let h = (xmax + 0.0) / cols as f64;
-    let rows = (ymax / h).ceil() as usize + 1;
-    let field = Interpolant::new(&pts);
-    let mut cells = Vec::new();
-    for j in 0..rows {
-        for i in 0..=cols {
-            let (x, y) = ((i as f64 + 0.5) * h, (j as f64 + 0.5) * h);
-            let v = unit_of(x, y);
-            if v.y < 0.0 || v.x < v.y || v.z < v.x {
-                continue;
+impl Figure for IpfMap {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> anyhow::Result<()> {
+        let map = self;
+        let (main, bar) = root.split_horizontally(520);
+        // Reduced to the triangle (the cubic symmetry), as unit vectors.
+        let pts: Vec<(Vector3<f64>, f64)> = map
+            .points
+            .iter()
+            .map(|(n, v)| {
+                let (x, y) = ipf_xy(*n);
+                (unit_of(x, y), *v)
+            })
+            .collect();
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.1), b.max(p.1))
+            });
+        let (lo, hi) = if hi > lo {
+            (lo, hi)
+        } else {
+            (lo - 0.5, lo + 0.5)
+        };
+        let xmax = (0.5_f64).sqrt() / (1.0 + 0.5_f64.sqrt());
+        let ymax = (1.0 / 3.0_f64.sqrt()) / (1.0 + 1.0 / 3.0_f64.sqrt());
+        // No label areas: the triangle's corners are labelled instead.
+        let frame = Frame {
+            title: 15,
+            margin: 20,
+            labels: (0, 0),
+        };
+        let mut chart = frame.chart(&main, &map.title, -0.03..xmax + 0.03, -0.05..ymax + 0.06)?;
+        // Fill: cells of the projected plane inside the triangle.
+        let cols = 110;
+        let h = (xmax + 0.0) / cols as f64;
+        let rows = (ymax / h).ceil() as usize + 1;
+        let field = Interpolant::new(&pts);
+        let mut cells = Vec::new();
+        for j in 0..rows {
+            for i in 0..=cols {
+                let (x, y) = ((i as f64 + 0.5) * h, (j as f64 + 0.5) * h);
+                let v = unit_of(x, y);
+                if v.y < 0.0 || v.x < v.y || v.z < v.x {
+                    continue;
+                }
+                let t = (field.at(x, y) - lo) / (hi - lo);
+                cells.push(Rectangle::new(
+                    [(x - 0.5 * h, y - 0.5 * h), (x + 0.5 * h, y + 0.5 * h)],
+                    ramp(t).filled(),
+                ));
             }
-            let t = (field.at(x, y) - lo) / (hi - lo);
-            cells.push(Rectangle::new(
-                [(x - 0.5 * h, y - 0.5 * h), (x + 0.5 * h, y + 0.5 * h)],
-                crate::maps::ramp(t).filled(),
-            ));
         }
-    }
-    chart.draw_series(cells).map_err(e)?;
-    // The triangle's edges: (001)–(101), (001)–(111) straight, (101)–(111)
-    // the projected great circle z = x.
-    let mut edge: Vec<(f64, f64)> = vec![(0.0, 0.0), (xmax, 0.0)];
-    let (a, b) = (
-        Vector3::<f64>::new(1.0, 0.0, 1.0).normalize(),
-        Vector3::<f64>::new(1.0, 1.0, 1.0).normalize(),
-    );
-    let arc = a.dot(&b).acos();
-    for k in 0..=40 {
-        let t = k as f64 / 40.0;
-        let v = (a * ((1.0 - t) * arc).sin() + b * (t * arc).sin()) / arc.sin();
-        edge.push((v.x / (1.0 + v.z), v.y / (1.0 + v.z)));
-    }
-    edge.push((0.0, 0.0));
-    chart
-        .draw_series(std::iter::once(PathElement::new(
-            edge,
-            BLACK.stroke_width(2),
-        )))
-        .map_err(e)?;
-    chart
-        .draw_series(
-            pts.iter().map(|(v, _)| {
-                Circle::new((v.x / (1.0 + v.z), v.y / (1.0 + v.z)), 3, BLACK.filled())
-            }),
-        )
-        .map_err(e)?;
-    let font = ("sans-serif", 16).into_font();
-    for (text, at) in [
-        ("001", (-0.025, -0.03)),
-        ("101", (xmax - 0.02, -0.03)),
-        ("111", (ymax - 0.02, ymax + 0.02)),
-    ] {
+        chart.draw_series(cells).map_err(err)?;
+        // The triangle's edges: (001)–(101), (001)–(111) straight, (101)–(111)
+        // the projected great circle z = x.
+        let mut edge: Vec<(f64, f64)> = vec![(0.0, 0.0), (xmax, 0.0)];
+        let (a, b) = (
+            Vector3::<f64>::new(1.0, 0.0, 1.0).normalize(),
+            Vector3::<f64>::new(1.0, 1.0, 1.0).normalize(),
+        );
+        let arc = a.dot(&b).acos();
+        for k in 0..=40 {
+            let t = k as f64 / 40.0;
+            let v = (a * ((1.0 - t) * arc).sin() + b * (t * arc).sin()) / arc.sin();
+            edge.push((v.x / (1.0 + v.z), v.y / (1.0 + v.z)));
+        }
+        edge.push((0.0, 0.0));
         chart
-            .draw_series(std::iter::once(Text::new(text, at, font.clone())))
-            .map_err(e)?;
+            .draw_series(std::iter::once(PathElement::new(
+                edge,
+                BLACK.stroke_width(2),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(pts.iter().map(|(v, _)| {
+                Circle::new((v.x / (1.0 + v.z), v.y / (1.0 + v.z)), 3, BLACK.filled())
+            }))
+            .map_err(err)?;
+        let font = ("sans-serif", 16).into_font();
+        for (text, at) in [
+            ("001", (-0.025, -0.03)),
+            ("101", (xmax - 0.02, -0.03)),
+            ("111", (ymax - 0.02, ymax + 0.02)),
+        ] {
+            chart
+                .draw_series(std::iter::once(Text::new(text, at, font.clone())))
+                .map_err(err)?;
+        }
+        // Colour bar, with as many decimals as its span needs (three figures
+        // of the difference).
+        let decimals = ((-(hi - lo).log10()).ceil() + 2.0).clamp(0.0, 8.0) as usize;
+        ColourBar {
+            label: &map.label,
+            title: 13,
+            margins: [30, 40, 6, 0],
+            ticks: 12,
+            decimals,
+            steps: 120,
+        }
+        .draw(&bar, lo, hi)
     }
-    // Colour bar, with as many decimals as its span needs (three figures
-    // of the difference).
-    let decimals = ((-(hi - lo).log10()).ceil() + 2.0).clamp(0.0, 8.0) as usize;
-    let mut cb = ChartBuilder::on(&bar)
-        .caption(&map.label, ("sans-serif", 13))
-        .margin_top(30)
-        .margin_bottom(40)
-        .margin_left(6)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(e)?;
-    cb.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_label_style(("sans-serif", 12))
-        .y_label_formatter(&|v| format!("{v:.decimals$}"))
-        .draw()
-        .map_err(e)?;
-    let steps = 120;
-    cb.draw_series((0..steps).map(|k| {
-        let v0 = lo + (hi - lo) * k as f64 / steps as f64;
-        let v1 = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
-        Rectangle::new(
-            [(0.0, v0), (1.0, v1)],
-            crate::maps::ramp((k as f64 + 0.5) / steps as f64).filled(),
-        )
-    }))
-    .map_err(e)?;
-    root.present().map_err(e)?;
-    Ok(())
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //! which states and where ([`compute`]), the scalars `case.json` carries
 //! ([`StressScalars`]) and the files ([`write`]: `stress/*.npy` and PNG maps
 //! with the contact edge marked). The stresses themselves are
-//! `solver::stress`; nothing here changes a solve.
+//! `solver::stress`; nothing here changes a solve. Called by `solve`,
+//! Python and the sweep's outputs (`sweep`); imports none of them.
 
 use std::path::Path;
 
@@ -34,20 +35,6 @@ impl std::ops::Deref for StressOutput {
 
 /// A scalar of the stress tensor.
 type Invariant = fn([f64; 6]) -> f64;
-
-impl StressCfg {
-    /// The solver's form of the section.
-    pub fn request(&self) -> StressRequest {
-        StressRequest {
-            depths_m: self.depths_um.iter().map(|d| d * 1e-6).collect(),
-            slices: self.slices,
-            slice_depth_m: self.slice_depth_um.map(|d| d * 1e-6),
-            slice_rows: self.slice_rows,
-            turning_states: self.states == "turning",
-            crossland_alpha: self.crossland_alpha,
-        }
-    }
-}
 
 /// Computes the stresses `cfg` asks for on the states of a solved case
 /// (see [`solver::stress_summary::compute`]).
@@ -165,7 +152,7 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
     let dir = dir.join("stress");
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("cannot create {}: {e}", dir.display()))?;
     for arr in arrays(so) {
-        crate::npy::write_npy_2d(
+        super::npy::write_npy_2d(
             &dir.join(format!("{}.npy", arr.name)),
             arr.rows,
             arr.cols,
@@ -178,8 +165,8 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
     let a = so.contact_radius_m;
     let rows = so.scalars.slice_depths_m.len();
     let z_max = so.scalars.slice_depths_m.last().copied().unwrap_or(0.0);
-    let mut draw = |file: String, heat: &crate::maps::Heat| {
-        if let Err(e) = crate::maps::write_heat(&dir.join(&file), heat) {
+    let mut draw = |file: String, heat: &super::maps::Heat| {
+        if let Err(e) = super::maps::write_heat(&dir.join(&file), heat) {
             warnings.push(format!("{file} not drawn: {e:#}"));
         }
     };
@@ -194,7 +181,7 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
             let t = format!("{title}, z = {:.3} a{suffix}", so.depths_m[k] / a);
             draw(
                 format!("{stem}_von_mises.png"),
-                &crate::maps::Heat {
+                &super::maps::Heat {
                     title: &t,
                     label: "von Mises / p_H",
                     cols: n,
@@ -225,7 +212,7 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
             let t = format!("{title}, slice {label} the force{suffix}");
             draw(
                 format!("slice_{label}{suffix}_von_mises.png"),
-                &crate::maps::Heat {
+                &super::maps::Heat {
                     title: &t,
                     label: "von Mises / p_H",
                     cols: n,
@@ -272,62 +259,4 @@ fn line_edge(
         .filter(|&i| (at(i) > 0.0) != (at(i - 1) > 0.0))
         .map(|i| (0.5 * (coord(i) + coord(i - 1)) / a, 0.0))
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::config::Config;
-    use crate::solve::{solve_in_memory, write_solved, CaseChoice};
-
-    const FE: &str = "[grid]\npoints = 64\nspacing_um = 5.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.28571\n[sweep]\nmaterials = [\"Fe\"]\nangles_deg = [0.0]\n[history]\ntangential_ratios = [0.0, 0.6, -0.6]\nsteps_per_segment = 2\n";
-
-    /// A fretting path's turning states: the frictionless start has the
-    /// Hertz von Mises peak (0.62 p_H, Hamilton), the two reversed
-    /// states mirror each other (trailing-edge tension behind the force),
-    /// and the files and keys appear only with the section.
-    #[test]
-    fn issue38_turning_states_mirror_and_outputs_only_with_the_section() {
-        let text = format!("{FE}[stress]\ndepths_um = [0.0]\nslice_rows = 16\n");
-        let c = Config::parse(&text, &[]).unwrap();
-        let solved = solve_in_memory(CaseChoice::new(&c, None, None, None).unwrap(), 1).unwrap();
-        let s = &solved.stress.as_ref().unwrap().scalars;
-        let steps: Vec<_> = s.states.iter().map(|st| st.step).collect();
-        assert_eq!(steps, vec![Some(0), Some(2), Some(4)]);
-        let start = s.states[0].max_von_mises.over_p_h;
-        assert!(
-            (start - 0.62).abs() < 0.02,
-            "frictionless von Mises {start}"
-        );
-        let (plus, minus) = (
-            s.states[1].surface_peak_along_force.unwrap(),
-            s.states[2].surface_peak_along_force.unwrap(),
-        );
-        assert!(
-            plus.at_m[0] < 0.0 && minus.at_m[0] > 0.0,
-            "{plus:?} {minus:?}"
-        );
-        assert!((plus.value_pa / minus.value_pa - 1.0).abs() < 0.01);
-        assert!(s.crossland.unwrap().value_pa > 0.0);
-        let dir = std::env::temp_dir().join(format!("mpc-stress-{}", std::process::id()));
-        write_solved(&solved, &dir).unwrap();
-        let json = std::fs::read_to_string(dir.join("case.json")).unwrap();
-        assert!(json.contains("\"stress\""));
-        for f in [
-            "plane_0um_step2_sxx.npy",
-            "slice_along_step4_von_mises.npy",
-            "slice_across_crossland.npy",
-        ] {
-            assert!(dir.join("stress").join(f).is_file(), "{f}");
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
-
-        let plain = Config::parse(FE, &[]).unwrap();
-        let solved =
-            solve_in_memory(CaseChoice::new(&plain, None, None, None).unwrap(), 1).unwrap();
-        assert!(solved.stress.is_none());
-        write_solved(&solved, &dir).unwrap();
-        let json = std::fs::read_to_string(dir.join("case.json")).unwrap();
-        assert!(!json.contains("\"stress\"") && !dir.join("stress").exists());
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
 }

@@ -1,22 +1,24 @@
-//! The files a sweep writes: `results.csv`, `curves.csv`, `mu_a_vs_angle.{png,svg}`
-//! and `fields/<case>/*.npy`. Formatting is deterministic (rows sorted by the
-//! case's display text, shortest round-trip floats) so that the CSVs do not
-//! depend on the number of workers. Owns no IPC, no journal and no physics
-//! beyond the K_E calibration call into the solver.
+//! The files a sweep writes: `results.csv`, `curves.csv`,
+//! `mu_a_vs_angle.{png,svg}` and `fields/<case>/` (`*.npy`, `stress/`), from
+//! [`Row`]s (plain data: the run makes them from its plan and journal, K_E
+//! calibrated). Formatting is deterministic (rows sorted by the case's
+//! display text, shortest round-trip floats) so that the CSVs do not depend
+//! on the number of workers. Owns no IPC, no journal and no physics.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use plotters::prelude::*;
 use serde::Serialize;
-use solver::{calibrate_on_flat, CaseScalars};
+use solver::stress_summary::StressScalars;
+use solver::{CaseScalars, CaseSpec};
 
-use super::journal::Outcome;
-use super::plan::PlannedCase;
+use super::plot::{self, err, Area, Figure, Frame, Panels, PALETTE};
 use crate::case::{CaseKey, Status};
 use crate::convergence::{estimate, Estimate};
-use crate::float_text::fmt_f64;
+use crate::float_text::{fmt_f64, fmt_opt as opt};
 
 /// Header of `results.csv` (one row per case, see README.md). Users' tools
 /// read these names: change one only with a reason in the docs.
@@ -38,7 +40,7 @@ pub const CURVES_STRESS_COLUMNS: &str =
     "max_von_mises_over_p_h,max_tresca_over_p_h,surface_peak_over_p_h,swt_pa";
 
 /// The cells of [`RESULTS_STRESS_COLUMNS`] (empty without stress scalars).
-fn stress_cells(s: Option<&solver::stress_summary::StressScalars>) -> String {
+fn stress_cells(s: Option<&StressScalars>) -> String {
     use solver::stress_summary::Located;
     let Some(s) = s else {
         return ",".repeat(RESULTS_STRESS_COLUMNS.matches(',').count());
@@ -140,62 +142,30 @@ fn identity_cells(key: &CaseKey, axes: Axes) -> String {
     cells
 }
 
-/// A finished case ready for output: its plan entry, its record and the
-/// scalars after K_E calibration.
+/// A finished case as the outputs see it: its identity and spec, what its
+/// worker recorded, and its scalars after K_E calibration (the run's
+/// `calibrate` makes them from the plan and the journal).
 pub struct Row<'a> {
-    /// Plan entry.
-    pub case: &'a PlannedCase,
-    /// Its recorded outcome.
-    pub record: &'a Outcome,
+    /// The case.
+    pub key: &'a CaseKey,
+    /// Its spec.
+    pub spec: &'a CaseSpec,
+    /// `ok`, `not_converged` or `failed`.
+    pub status: Status,
+    /// Solve wall time in the worker, s.
+    pub seconds: f64,
+    /// Worker that solved it.
+    pub worker: u32,
+    /// With `[stress]`: the worker's stress scalars.
+    pub stress: Option<&'a StressScalars>,
     /// Scalars with the final μa and K_E.
     pub scalars: Option<CaseScalars>,
 }
 
-/// Apply the K_E calibration: patterned (and flat) cases of anisotropic
-/// materials get K_E(ψ) from the flat case of the same material, grid and
-/// angle, and μa recomputed with it. Cases without a flat twin keep the
-/// worker's isotropic-equivalent K_E.
-/// `records[i]` is the outcome of `cases[i]` (None: not recorded).
-pub fn calibrate<'a>(cases: &'a [PlannedCase], records: &'a [Option<Outcome>]) -> Vec<Row<'a>> {
-    let mut rows = Vec::new();
-    for (case, record) in cases.iter().zip(records) {
-        let Some(record) = record else {
-            continue;
-        };
-        let mut scalars = record.scalars.clone();
-        if let Some(s) = scalars.as_mut() {
-            let spec = &case.spec;
-            if spec.needs_flat_calibration() {
-                let twin_spec = spec.flat_twin();
-                let twin = cases.iter().position(|c| c.spec == twin_spec);
-                let flat = twin
-                    .and_then(|t| records.get(t).and_then(Option::as_ref))
-                    .filter(|r| r.status != Status::Failed)
-                    .and_then(|r| r.scalars.as_ref());
-                if let Some(flat) = flat {
-                    calibrate_on_flat(s, flat, &spec.load);
-                }
-            }
-        }
-        rows.push(Row {
-            case,
-            record,
-            scalars,
-        });
-    }
-    // The order of the display text (as when cases were named by strings).
-    rows.sort_by_cached_key(|r| r.case.key.to_string());
-    rows
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map(fmt_f64).unwrap_or_default()
-}
-
 /// Text of `results.csv` (with [`INDENTER_COLUMN`] in a sweep over balls).
 pub fn results_csv(rows: &[Row]) -> String {
-    let axes = Axes::of(rows.iter().map(|r| &r.case.key));
-    let stress = rows.iter().any(|r| r.record.stress.is_some());
+    let axes = Axes::of(rows.iter().map(|r| r.key));
+    let stress = rows.iter().any(|r| r.stress.is_some());
     let mut out = header_with_axes(RESULTS_HEADER, axes);
     if stress {
         out.push(',');
@@ -203,16 +173,15 @@ pub fn results_csv(rows: &[Row]) -> String {
     }
     out.push('\n');
     for r in rows {
-        let c = r.case;
         let s = r.scalars.as_ref();
         let f = |g: fn(&CaseScalars) -> f64| opt(s.map(g));
         let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
         let _ = write!(
             out,
             "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
-            identity_cells(&c.key, axes),
-            fmt_f64(c.spec.load.angle_deg),
-            r.record.status,
+            identity_cells(r.key, axes),
+            fmt_f64(r.spec.load.angle_deg),
+            r.status,
             opt(s.and_then(|s| s.mu_a)),
             f(|s| s.k_e),
             f(|s| s.contact_radius_m),
@@ -225,11 +194,11 @@ pub fn results_csv(rows: &[Row]) -> String {
             i(|s| s.normal_iterations),
             i(|s| s.tangential_iterations),
             i(|s| s.coupling_iterations),
-            r.record.seconds,
-            r.record.worker,
-            c.key.level,
-            c.spec.grid.n,
-            fmt_f64(c.spec.grid.dx),
+            r.seconds,
+            r.worker,
+            r.key.level,
+            r.spec.grid.n,
+            fmt_f64(r.spec.grid.dx),
             opt(s.and_then(|s| s.mu_a_cells)),
             f(|s| s.k_e_cells),
             f(|s| s.contact_radius_cells_m),
@@ -237,7 +206,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         );
         if stress {
             out.push(',');
-            out.push_str(&stress_cells(r.record.stress.as_ref()));
+            out.push_str(&stress_cells(r.stress));
         }
         out.push('\n');
     }
@@ -273,7 +242,7 @@ pub struct CurvePoint {
     /// closes a cycle), J: best value and error bar over the levels.
     pub dissipated: Option<Estimate>,
     /// With `[stress]`: the finest level's stress scalars.
-    pub stress: Option<solver::stress_summary::StressScalars>,
+    pub stress: Option<StressScalars>,
 }
 
 /// The curve points of `rows`: each material × surface × angle whose
@@ -282,7 +251,7 @@ pub struct CurvePoint {
 pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
     let mut by_point: BTreeMap<String, (CaseKey, Vec<&Row>)> = BTreeMap::new();
     for r in rows {
-        let key = r.case.key.point();
+        let key = r.key.point();
         by_point
             .entry(key.to_string())
             .or_insert_with(|| (key, Vec::new()))
@@ -291,12 +260,12 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
     }
     let (mut points, mut incomplete) = (Vec::new(), 0);
     for (_, (key, mut rs)) in by_point {
-        rs.sort_by_key(|r| r.case.key.level);
+        rs.sort_by_key(|r| r.key.level);
         // (cell size, scalars) of every level that solved and converged.
         let solved: Vec<(f64, &CaseScalars)> = rs
             .iter()
-            .filter(|r| r.record.status == Status::Ok)
-            .filter_map(|r| Some((r.case.spec.grid.dx, r.scalars.as_ref()?)))
+            .filter(|r| r.status == Status::Ok)
+            .filter_map(|r| Some((r.spec.grid.dx, r.scalars.as_ref()?)))
             .collect();
         if solved.len() != levels {
             incomplete += 1;
@@ -328,14 +297,14 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             k_e,
             mu_a_by_level,
             mu_a_cells: finest.mu_a_cells,
-            flat_calibration: rs[0].case.spec.surface == solver::Surface::Flat
+            flat_calibration: rs[0].spec.surface == solver::Surface::Flat
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
             dissipated,
             stress: rs
                 .iter()
                 .rev()
-                .find(|r| r.record.status == Status::Ok)
-                .and_then(|r| r.record.stress.clone()),
+                .find(|r| r.status == Status::Ok)
+                .and_then(|r| r.stress.cloned()),
         });
     }
     (points, incomplete)
@@ -613,172 +582,145 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     if !k_e.series.is_empty() {
         panels.push(k_e);
     }
-    let cols = panels.len().clamp(1, 2);
-    let rows = panels.len().div_ceil(2).max(1);
-    let size = (560 * cols as u32 + 180, 400 * rows as u32);
-    let is_svg = path.extension().is_some_and(|e| e == "svg");
-    crate::atomic::replace_with(path, |tmp| {
-        if is_svg {
-            draw_panels(
-                SVGBackend::new(tmp, size).into_drawing_area(),
-                &panels,
-                cols,
-            )
-        } else {
-            draw_panels(
-                BitMapBackend::new(tmp, size).into_drawing_area(),
-                &panels,
-                cols,
-            )
-        }
-    })
+    let layout = Panels {
+        count: panels.len(),
+        legend: 180,
+    };
+    plot::write(path, layout.size(), &Curves { panels, layout })
 }
 
-use plotters::prelude::*;
+/// The sweep's figure: its panels in their grid beside the legend.
+struct Curves {
+    panels: Vec<Panel>,
+    layout: Panels,
+}
 
-fn draw_panels<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    panels: &[Panel],
-    cols: usize,
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(e)?;
-    // One colour and marker per series name, the same in every panel; flat black.
-    let names: Vec<&str> = {
-        let mut v: Vec<&str> = panels
-            .iter()
-            .flat_map(|p| p.series.keys().map(String::as_str))
-            .collect();
-        v.sort();
-        v.dedup();
-        v
-    };
-    let style_of = |name: &str| -> (RGBAColor, usize) {
-        let k = names.iter().position(|s| *s == name).unwrap_or(0);
-        // Distinct, print-safe colours (no yellow on white).
-        const COLOURS: [(u8, u8, u8); 8] = [
-            (31, 119, 180),
-            (214, 39, 40),
-            (44, 160, 44),
-            (255, 127, 14),
-            (148, 103, 189),
-            (140, 86, 75),
-            (227, 119, 194),
-            (23, 190, 207),
-        ];
-        if name == "flat" {
-            (BLACK.to_rgba(), 0)
-        } else {
-            let (r, g, b) = COLOURS[k % COLOURS.len()];
-            (RGBColor(r, g, b).to_rgba(), k % 3)
-        }
-    };
-    let (plot_area, legend_area) = root.split_horizontally(root.dim_in_pixel().0 - 180);
-    let rows = panels.len().div_ceil(cols).max(1);
-    let areas = plot_area.split_evenly((rows, cols));
-    for (panel, area) in panels.iter().zip(areas.iter()) {
-        let (mut lo, mut hi, mut xlo, mut xhi) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for &(x, y, err) in panel.series.values().flatten() {
-            let err = err.unwrap_or(0.0);
-            lo = lo.min(y - err);
-            hi = hi.max(y + err);
-            xlo = xlo.min(x);
-            xhi = xhi.max(x);
-        }
-        if !lo.is_finite() {
-            (lo, hi, xlo, xhi) = (0.0, 1.0, 0.0, 180.0);
-        }
-        let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1.0));
-        if xhi <= xlo {
-            (xlo, xhi) = (xlo - 1.0, xhi + 1.0);
-        }
-        let xpad = (xhi - xlo) * 0.03;
-        let mut chart = ChartBuilder::on(area)
-            .caption(&panel.title, ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d((xlo - xpad)..(xhi + xpad), (lo - pad)..(hi + pad))
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc("force angle ψ (deg)")
-            .y_desc(panel.y_desc)
-            .x_label_formatter(&|x| format!("{x:.0}"))
-            .draw()
-            .map_err(e)?;
-        for (name, pts) in &panel.series {
-            let (color, marker) = style_of(name);
-            let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();
+impl Figure for Curves {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> anyhow::Result<()> {
+        let panels = &self.panels;
+        // One colour and marker per series name, the same in every panel; flat black.
+        let names: Vec<&str> = {
+            let mut v: Vec<&str> = panels
+                .iter()
+                .flat_map(|p| p.series.keys().map(String::as_str))
+                .collect();
+            v.sort();
+            v.dedup();
+            v
+        };
+        let style_of = |name: &str| -> (RGBAColor, usize) {
+            let k = names.iter().position(|s| *s == name).unwrap_or(0);
+            if name == "flat" {
+                (BLACK.to_rgba(), 0)
+            } else {
+                (PALETTE[k % PALETTE.len()].to_rgba(), k % 3)
+            }
+        };
+        let (areas, legend_area) = self.layout.split(root);
+        for (panel, area) in panels.iter().zip(areas.iter()) {
+            let (mut lo, mut hi, mut xlo, mut xhi) = (
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            );
+            for &(x, y, err) in panel.series.values().flatten() {
+                let err = err.unwrap_or(0.0);
+                lo = lo.min(y - err);
+                hi = hi.max(y + err);
+                xlo = xlo.min(x);
+                xhi = xhi.max(x);
+            }
+            if !lo.is_finite() {
+                (lo, hi, xlo, xhi) = (0.0, 1.0, 0.0, 180.0);
+            }
+            let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1.0));
+            if xhi <= xlo {
+                (xlo, xhi) = (xlo - 1.0, xhi + 1.0);
+            }
+            let xpad = (xhi - xlo) * 0.03;
+            let frame = Frame {
+                title: 20,
+                margin: 10,
+                labels: (40, 60),
+            };
+            let mut chart = frame.chart(
+                area,
+                &panel.title,
+                (xlo - xpad)..(xhi + xpad),
+                (lo - pad)..(hi + pad),
+            )?;
             chart
-                .draw_series(LineSeries::new(line.iter().copied(), color.stroke_width(2)))
-                .map_err(e)?;
+                .configure_mesh()
+                .x_desc("force angle ψ (deg)")
+                .y_desc(panel.y_desc)
+                .x_label_formatter(&|x| format!("{x:.0}"))
+                .draw()
+                .map_err(err)?;
+            for (name, pts) in &panel.series {
+                let (color, marker) = style_of(name);
+                let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();
+                chart
+                    .draw_series(LineSeries::new(line.iter().copied(), color.stroke_width(2)))
+                    .map_err(err)?;
+                let style = color.filled();
+                match marker {
+                    0 => chart
+                        .draw_series(line.iter().map(|&c| Circle::new(c, 4, style)))
+                        .map(|_| ()),
+                    1 => chart
+                        .draw_series(line.iter().map(|&c| TriangleMarker::new(c, 5, style)))
+                        .map(|_| ()),
+                    _ => chart
+                        .draw_series(
+                            line.iter()
+                                .map(|&c| Cross::new(c, 5, color.stroke_width(2))),
+                        )
+                        .map(|_| ()),
+                }
+                .map_err(err)?;
+                chart
+                    .draw_series(pts.iter().filter_map(|&(x, y, err)| {
+                        let err = err.filter(|&v| v > 0.0)?;
+                        Some(ErrorBar::new_vertical(
+                            x,
+                            y - err,
+                            y,
+                            y + err,
+                            color.stroke_width(1),
+                            6,
+                        ))
+                    }))
+                    .map_err(err)?;
+            }
+        }
+        // The legend beside the panels, never over the data.
+        for (k, name) in names.iter().enumerate() {
+            let (color, marker) = style_of(name);
+            let y = 30 + 24 * k as i32;
+            legend_area
+                .draw(&PathElement::new(
+                    vec![(10, y), (40, y)],
+                    color.stroke_width(3),
+                ))
+                .map_err(err)?;
             let style = color.filled();
             match marker {
-                0 => chart
-                    .draw_series(line.iter().map(|&c| Circle::new(c, 4, style)))
-                    .map(|_| ()),
-                1 => chart
-                    .draw_series(line.iter().map(|&c| TriangleMarker::new(c, 5, style)))
-                    .map(|_| ()),
-                _ => chart
-                    .draw_series(
-                        line.iter()
-                            .map(|&c| Cross::new(c, 5, color.stroke_width(2))),
-                    )
-                    .map(|_| ()),
+                0 => legend_area.draw(&Circle::new((25, y), 4, style)),
+                1 => legend_area.draw(&TriangleMarker::new((25, y), 5, style)),
+                _ => legend_area.draw(&Cross::new((25, y), 5, color.stroke_width(2))),
             }
-            .map_err(e)?;
-            chart
-                .draw_series(pts.iter().filter_map(|&(x, y, err)| {
-                    let err = err.filter(|&v| v > 0.0)?;
-                    Some(ErrorBar::new_vertical(
-                        x,
-                        y - err,
-                        y,
-                        y + err,
-                        color.stroke_width(1),
-                        6,
-                    ))
-                }))
-                .map_err(e)?;
+            .map_err(err)?;
+            legend_area
+                .draw(&Text::new(
+                    name.to_string(),
+                    (48, y - 8),
+                    ("sans-serif", 16),
+                ))
+                .map_err(err)?;
         }
+        Ok(())
     }
-    // The legend beside the panels, never over the data.
-    for (k, name) in names.iter().enumerate() {
-        let (color, marker) = style_of(name);
-        let y = 30 + 24 * k as i32;
-        legend_area
-            .draw(&PathElement::new(
-                vec![(10, y), (40, y)],
-                color.stroke_width(3),
-            ))
-            .map_err(e)?;
-        let style = color.filled();
-        match marker {
-            0 => legend_area.draw(&Circle::new((25, y), 4, style)),
-            1 => legend_area.draw(&TriangleMarker::new((25, y), 5, style)),
-            _ => legend_area.draw(&Cross::new((25, y), 5, color.stroke_width(2))),
-        }
-        .map_err(e)?;
-        legend_area
-            .draw(&Text::new(
-                name.to_string(),
-                (48, y - 8),
-                ("sans-serif", 16),
-            ))
-            .map_err(e)?;
-    }
-    root.present().map_err(e)?;
-    Ok(())
 }
 
 /// Directory of a case's fields: `fields/<material>/<surface>/<angle>`
@@ -832,7 +774,7 @@ pub fn write_result_fields(
     for (k, name) in names.iter().enumerate() {
         let data = protocol::read_field(field_bytes, k, n * n)
             .ok_or_else(|| anyhow::anyhow!("field {name} missing"))?;
-        crate::npy::write_npy(&dir.join(format!("{name}.npy")), n, &data)?;
+        super::npy::write_npy(&dir.join(format!("{name}.npy")), n, &data)?;
     }
     Ok(())
 }
@@ -873,145 +815,15 @@ pub fn write_stress_fields(
         qy: get("qy")?,
         ..Default::default()
     };
-    let so = crate::stress_out::compute(cfg, spec, scalars, &fields, &[])?;
+    let so = super::stress::compute(cfg, spec, scalars, &fields, &[])?;
     let title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
-    let warnings = crate::stress_out::write(&fields_dir(out_dir, key), &so, &title)?;
+    let warnings = super::stress::write(&fields_dir(out_dir, key), &so, &title)?;
     Ok((!warnings.is_empty()).then(|| format!("{key}: {}", warnings.join("; "))))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use solver::{calibrate_k_e, mu_apparent, CaseSpec, Surface};
-
-    fn aniso_case(surface_name: &str, surface: Surface) -> PlannedCase {
-        let iso = solver::Isotropic::new(130e9, 0.34).unwrap();
-        let mut c = iso.stiffness();
-        c[(0, 0)] *= 1.2;
-        let spec = CaseSpec {
-            material: solver::Material {
-                name: "Cu(111)".into(),
-                elasticity: solver::Elasticity::Anisotropic(solver::Anisotropic(c)),
-                equivalent: iso,
-            },
-            surface,
-            grid: solver::Grid::square(32, 1e-4),
-            load: solver::Load {
-                indenter_radius_m: 0.2,
-                normal_force_n: 6000.0,
-                friction: 0.3,
-                tangential_ratio: 0.6,
-                angle_deg: 30.0,
-            },
-            numerics: super::super::plan::tests::quick_numerics(),
-            history: None,
-            indenter: None,
-        };
-        let key = CaseKey::new("Cu(111)", surface_name, 30.0);
-        let mut plan = super::super::plan::Plan::new(vec![(key, spec)]);
-        plan.cases.remove(0)
-    }
-
-    fn record(a: f64, c: f64, dt: f64) -> Outcome {
-        Outcome {
-            status: Status::Ok,
-            error: None,
-            worker: 0,
-            seconds: 1.0,
-            kernel_builds: 1,
-            scalars: Some(CaseScalars {
-                contact_radius_m: a,
-                stick_radius_m: c,
-                delta_t_m: dt,
-                mu_a: Some(0.0),
-                k_e: 1.0,
-                ..Default::default()
-            }),
-            stress: None,
-        }
-    }
-
-    #[test]
-    fn anisotropic_mu_a_uses_k_e_from_the_flat_twin() {
-        let lattice = solver::presets::surface("circle-A").expect("a preset");
-        let flat = aniso_case("flat", Surface::Flat);
-        let pat = aniso_case("circle-A", lattice);
-        assert!(flat.calibration && !pat.calibration);
-        let cases = vec![pat, flat];
-        let records = vec![
-            Some(record(2.5e-3, 1.4e-3, 4e-6)),
-            Some(record(2e-3, 1.5e-3, 3e-6)),
-        ];
-        let rows = calibrate(&cases, &records);
-        let flat_row = rows.iter().find(|r| r.case.key.surface == "flat").unwrap();
-        let pat_row = rows
-            .iter()
-            .find(|r| r.case.key.surface == "circle-A")
-            .unwrap();
-        let fs = flat_row.scalars.as_ref().unwrap();
-        // By construction Eq. 19 with the calibrated K_E returns μ on the flat case.
-        assert!((fs.mu_a.unwrap() - 0.3).abs() < 1e-12, "{:?}", fs.mu_a);
-        let outcome = |i: usize| records[i].as_ref().unwrap();
-        let k_e = calibrate_k_e(outcome(1).scalars.as_ref().unwrap(), 0.3, 6000.0);
-        let ps = pat_row.scalars.as_ref().unwrap();
-        assert_eq!(ps.k_e, k_e);
-        assert_eq!(ps.k_e_source, "flat-calibrated");
-        let want = mu_apparent(outcome(0).scalars.as_ref().unwrap(), 6000.0, k_e);
-        assert_eq!(ps.mu_a.unwrap(), want);
-        assert_eq!(pat_row.case.key.to_string(), "Cu(111)/circle-A/030.0");
-    }
-
-    #[test]
-    fn issue35_each_ball_calibrates_on_its_own_flat_twin() {
-        let lattice = solver::presets::surface("circle-A").expect("a preset");
-        let steel = solver::presets::material("steel").unwrap();
-        let with_ball = |mut c: PlannedCase, ball: Option<&solver::Material>| {
-            let name = ball.map_or("rigid", |m| m.name.as_str());
-            c.key = c.key.with_indenter(name);
-            c.spec.indenter = ball.cloned();
-            c
-        };
-        let cases = vec![
-            with_ball(aniso_case("circle-A", lattice.clone()), None),
-            with_ball(aniso_case("flat", Surface::Flat), None),
-            with_ball(aniso_case("circle-A", lattice), Some(&steel)),
-            with_ball(aniso_case("flat", Surface::Flat), Some(&steel)),
-        ];
-        let records = vec![
-            Some(record(2.5e-3, 1.4e-3, 4e-6)),
-            Some(record(2e-3, 1.5e-3, 3e-6)),
-            Some(record(2.9e-3, 1.6e-3, 5e-6)),
-            Some(record(2.4e-3, 1.7e-3, 6e-6)),
-        ];
-        let rows = calibrate(&cases, &records);
-        let ids: Vec<String> = rows.iter().map(|r| r.case.key.to_string()).collect();
-        assert_eq!(
-            ids,
-            [
-                "Cu(111)/circle-A/030.0@rigid",
-                "Cu(111)/circle-A/030.0@steel",
-                "Cu(111)/flat/030.0@rigid",
-                "Cu(111)/flat/030.0@steel",
-            ]
-        );
-        let flat_k_e = |i: usize| {
-            calibrate_k_e(
-                records[i].as_ref().unwrap().scalars.as_ref().unwrap(),
-                0.3,
-                6000.0,
-            )
-        };
-        assert_ne!(flat_k_e(1), flat_k_e(3));
-        assert_eq!(rows[0].scalars.as_ref().unwrap().k_e, flat_k_e(1));
-        assert_eq!(rows[1].scalars.as_ref().unwrap().k_e, flat_k_e(3));
-        // The CSVs name the ball after the surface.
-        let csv = results_csv(&rows);
-        assert!(
-            csv.starts_with("material,surface,indenter,angle_deg,status,"),
-            "{csv}"
-        );
-        assert!(csv.contains("\nCu(111),circle-A,steel,30,ok,"), "{csv}");
-    }
 
     #[test]
     fn fields_dir_is_safe() {

@@ -14,12 +14,12 @@ use worker::WireScalars;
 
 use super::exchange::{unix_ns, Exchange, Next, Request};
 use super::journal::Outcome;
-use super::output;
 use super::progress::Progress;
 use super::record::Recorder;
 use super::summary::{IpcStats, IpcTimes, WorkerSummary};
 use super::supervise::{Supervisor, Verdict};
 use crate::case::{CaseKey, Status};
+use crate::output::sweep;
 
 /// Liveness check period.
 const TICK: Duration = Duration::from_millis(500);
@@ -267,7 +267,7 @@ impl<'a> Dispatch<'a> {
             return Ok(());
         }
         if want_fields {
-            output::write_result_fields(
+            sweep::write_result_fields(
                 self.args.out_dir,
                 &h.key,
                 n as usize,
@@ -275,7 +275,7 @@ impl<'a> Dispatch<'a> {
                 field_bytes,
             )?;
             if let Some(cfg) = &self.args.stress {
-                let note = output::write_stress_fields(
+                let note = sweep::write_stress_fields(
                     self.args.out_dir,
                     &case.key,
                     &case.spec,

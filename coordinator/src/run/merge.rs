@@ -51,7 +51,7 @@ pub(super) fn write_shard_info(
             }
         }
     }
-    crate::atomic::write(
+    crate::output::atomic::write(
         &path,
         (serde_json::to_string_pretty(&info)? + "\n").as_bytes(),
     )

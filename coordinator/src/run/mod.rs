@@ -7,19 +7,15 @@
 //! [`run_sweep`]: lock the output directory (`lock`) → plan the cases
 //! (`plan`) → open the record (`record`, resuming the journal) → start
 //! workers (`supervise`) and serve them (`dispatch` over `exchange`) until
-//! every case is recorded → write the outputs (`output`, `summary`).
+//! every case is recorded → write the outputs (`calibrate` into rows, then
+//! `crate::output`, and `summary`).
 
+mod calibrate;
 mod dispatch;
 mod exchange;
-#[path = "../output/fretting_map.rs"]
-mod fretting_map;
 mod journal;
 mod lock;
 mod merge;
-#[path = "../output/orientation_map.rs"]
-mod orientation_map;
-#[path = "../output/sweep.rs"]
-mod output;
 mod plan;
 mod progress;
 mod record;
@@ -32,17 +28,20 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use anyhow::Context;
 use serde::Serialize;
 
+pub use crate::output::fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
+pub use crate::output::orientation_map::ORIENTATIONS_HEADER;
+pub use crate::output::sweep::{
+    CURVES_HEADER, CURVES_STRESS_COLUMNS, RESULTS_HEADER, RESULTS_STRESS_COLUMNS,
+};
 pub use exchange::Interrupted;
-pub use fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
 pub use merge::{merge_shards, ShardInfo, SHARD_FILE};
-pub use orientation_map::ORIENTATIONS_HEADER;
-pub use output::{CURVES_HEADER, CURVES_STRESS_COLUMNS, RESULTS_HEADER, RESULTS_STRESS_COLUMNS};
 pub use plan::{CaseState, Plan, PlannedCase};
 pub use summary::{IpcStats, RunSummary, WorkerSummary};
 pub use supervise::WorkerCommand;
 
 use crate::config::Config;
+use crate::output::{atomic, fretting_map, history, orientation_map, sweep};
 
 /// Everything `mpcontact run` passes to the runner.
 pub struct RunArgs {
@@ -247,12 +246,12 @@ fn write_outputs(
     raw_config: &str,
     orientations: &[crate::config::Orientation],
 ) -> anyhow::Result<()> {
-    let rows = output::calibrate(cases, outcomes);
-    let write = |name: &str, text: String| crate::atomic::write(&dir.join(name), text.as_bytes());
-    write("results.csv", output::results_csv(&rows))?;
+    let rows = calibrate::calibrate(cases, outcomes);
+    let write = |name: &str, text: String| atomic::write(&dir.join(name), text.as_bytes());
+    write("results.csv", sweep::results_csv(&rows))?;
     let levels = cases.iter().map(|c| c.key.level + 1).max().unwrap_or(1);
-    let (points, incomplete) = output::curve_points(&rows, levels);
-    write("curves.csv", output::curves_csv(&points))?;
+    let (points, incomplete) = sweep::curve_points(&rows, levels);
+    write("curves.csv", sweep::curves_csv(&points))?;
     // One definition per run (`solver.radii` is a key of the whole config).
     summary.apparent_radius_definition = cases
         .first()
@@ -264,7 +263,7 @@ fn write_outputs(
     summary.error_estimate = crate::convergence::ERROR_ESTIMATE;
     summary.convergence_levels = levels;
     summary.incomplete_points = incomplete;
-    summary.curves = output::curve_summaries(&points);
+    summary.curves = sweep::curve_summaries(&points);
     summary.sampling = cases
         .iter()
         .map(|c| {
@@ -281,7 +280,7 @@ fn write_outputs(
         let Some(h) = r.scalars.as_ref().and_then(|s| s.history.as_ref()) else {
             continue;
         };
-        let key = &r.case.key;
+        let key = r.key;
         let mut title = format!("{}, {}, ψ = {}°", key.material, key.surface, key.angle_deg);
         if let Some(ball) = &key.indenter {
             title.push_str(&format!(", {ball} ball"));
@@ -292,7 +291,7 @@ fn write_outputs(
         if let Some(a) = key.amplitude_um {
             title.push_str(&format!(", Δ = {a} µm"));
         }
-        match crate::history_out::write_history(&output::fields_dir(dir, key), h, &title) {
+        match history::write_history(&sweep::fields_dir(dir, key), h, &title) {
             Ok(warnings) => summary.output_warnings.extend(warnings),
             Err(e) => summary
                 .output_warnings
@@ -302,14 +301,14 @@ fn write_outputs(
     // With [stress]: each case's stress scalars beside its fields, the
     // value `mpcontact solve` puts under `stress` in case.json.
     for r in &rows {
-        let Some(s) = &r.record.stress else {
+        let Some(s) = r.stress else {
             continue;
         };
-        let dir = output::fields_dir(dir, &r.case.key);
+        let dir = sweep::fields_dir(dir, r.key);
         std::fs::create_dir_all(&dir)
             .with_context(|| format!("cannot create {}", dir.display()))?;
         let text = serde_json::to_string_pretty(s)? + "\n";
-        crate::atomic::write(&dir.join("stress.json"), text.as_bytes())?;
+        atomic::write(&dir.join("stress.json"), text.as_bytes())?;
     }
     // A fretting map (sweep.amplitudes_um): its table, transitions, figure.
     let map = fretting_map::map_points(&rows);
@@ -341,7 +340,7 @@ fn write_outputs(
         }
     }
     for name in ["mu_a_vs_angle.png", "mu_a_vs_angle.svg"] {
-        if let Err(e) = output::plot_curves(&dir.join(name), &points) {
+        if let Err(e) = sweep::plot_curves(&dir.join(name), &points) {
             summary.output_warnings.push(format!("{name}: {e:#}"));
         }
     }

@@ -146,7 +146,7 @@ pub struct RunSummary {
     /// Curve points left out because a level of their ladder did not solve.
     pub incomplete_points: usize,
     /// Per "material / surface": μa range over angle, error, resolved.
-    pub curves: BTreeMap<String, super::output::CurveSummary>,
+    pub curves: BTreeMap<String, crate::output::sweep::CurveSummary>,
     /// How K_E is obtained.
     pub k_e_definition: &'static str,
     /// By surface name, how its edges were put on the grid: `area` (the
