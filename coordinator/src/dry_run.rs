@@ -117,6 +117,9 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         config.sweep.surfaces.len(),
         list(&config.sweep.surfaces)
     );
+    for w in config.unresolved_patterns(&config.sweep.surfaces)? {
+        let _ = writeln!(s, "warning:   {w}");
+    }
     let shown: Vec<String> = angles.iter().map(|a| format!("{a}")).collect();
     let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
     let mut ball_axis = match &config.sweep.indenters {

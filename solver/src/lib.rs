@@ -108,7 +108,9 @@ pub use model::radii::{
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
 pub use model::spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
-pub use model::surface::{Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER};
+pub use model::surface::{
+    Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER, RESOLVED_CELLS_PER_PITCH,
+};
 pub use operators::kernels::{
     build_operator, build_pair_operator, persists, BuildLock, KernelKey, KernelStore,
 };

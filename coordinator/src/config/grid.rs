@@ -47,6 +47,22 @@ fn default_ratio() -> f64 {
 }
 
 impl Config {
+    /// A warning for each of `surfaces` whose pattern `[grid]` does not
+    /// resolve (fewer than [`solver::RESOLVED_CELLS_PER_PITCH`] cells per
+    /// pitch, [`solver::Surface::unresolved_pattern`]), naming the surface:
+    /// what `check`, `solve` and `run` print. Such cases are solved all the
+    /// same, on the pattern's exact cover per cell.
+    pub fn unresolved_patterns(&self, surfaces: &[String]) -> anyhow::Result<Vec<String>> {
+        let grid = self.level_grid(0);
+        let mut warnings = Vec::new();
+        for name in surfaces {
+            if let Some(w) = self.surface(name)?.unresolved_pattern(&grid) {
+                warnings.push(format!("surface `{name}`: {w}"));
+            }
+        }
+        Ok(warnings)
+    }
+
     /// The load of one case: the sphere of `[indenter]` under `[load]`, with
     /// `tangential_ratio` (the config's, or a load history's last) at `angle_deg`.
     pub(super) fn load_at(&self, tangential_ratio: f64, angle_deg: f64) -> Load {

@@ -400,7 +400,9 @@ impl Surface {
 
     /// Exact fraction of each cell's area on the islands or ridges
     /// (closed-form areas of [`crate::base::cover`]), row-major; zeros for flat
-    /// surfaces and height maps.
+    /// surfaces and height maps. A cell costs a handful of islands or
+    /// ridges however fine the pattern (whole periods in closed form,
+    /// [`lattice_area_tiled`], [`Ridges::area_in`]; #47).
     pub fn raised_fraction(&self, grid: &Grid) -> Vec<f64> {
         let n = grid.n;
         let mut f = vec![0.0; grid.len()];
@@ -417,6 +419,13 @@ impl Surface {
             } => {
                 let (s, c) = angle_deg.to_radians().sin_cos();
                 let (nx, ny) = (-s, c);
+                let ridges = Ridges {
+                    nx,
+                    ny,
+                    offset: *offset,
+                    width: *width,
+                    pitch: *pitch,
+                };
                 // Half the extent of a cell across the ridges.
                 let spread = 0.5 * (dx * s.abs() + dy * c.abs());
                 for iy in 0..n {
@@ -431,14 +440,7 @@ impl Surface {
                             || pitch - u.abs() - spread < 0.5 * width
                         {
                             let rect = Rect::cell(x, y, dx, dy);
-                            let k0 = ((d - spread - 0.5 * width) / pitch).ceil() as i64;
-                            let k1 = ((d + spread + 0.5 * width) / pitch).floor() as i64;
-                            let area: f64 = (k0..=k1)
-                                .map(|k| {
-                                    let line = offset + k as f64 * pitch;
-                                    strip_in_rect(nx, ny, line, *width, &rect)
-                                })
-                                .sum();
+                            let area = ridges.area_in(&rect, d, spread);
                             *cell = (area / rect.area()).min(1.0);
                         }
                     }
@@ -451,10 +453,7 @@ impl Surface {
                 lattice,
                 ..
             } => {
-                let reach = match island {
-                    Island::Circle { diameter } => 0.5 * diameter,
-                    Island::Square { side } => side * std::f64::consts::FRAC_1_SQRT_2,
-                };
+                let reach = island_reach(*island);
                 for iy in 0..n {
                     for ix in 0..n {
                         let (x, y) = (grid.x(ix), grid.y(iy));
@@ -475,8 +474,9 @@ impl Surface {
                             *cell = 1.0;
                         } else if u.hypot(v) - half_diagonal < reach {
                             let rect = Rect::cell(x, y, dx, dy);
-                            let area =
-                                lattice_area_in(*island, *lattice, *pitch, *offset, reach, &rect);
+                            let area = lattice_area_tiled(
+                                *island, *lattice, *pitch, *offset, reach, &rect,
+                            );
                             *cell = (area / rect.area()).min(1.0);
                         }
                     }
@@ -497,10 +497,7 @@ impl Surface {
                 lattice,
                 ..
             } => {
-                let a = match island {
-                    Island::Circle { diameter } => std::f64::consts::PI * diameter * diameter / 4.0,
-                    Island::Square { side } => side * side,
-                };
+                let a = island_area(*island);
                 let cell = match lattice {
                     LatticeKind::Square => pitch * pitch,
                     LatticeKind::Hexagonal => pitch * pitch * 3f64.sqrt() / 2.0,
@@ -509,7 +506,85 @@ impl Surface {
             }
         }
     }
+
+    /// The pattern's pitch in cells of `grid` (its larger side): how
+    /// finely the grid resolves the islands, ridges or dimples. `None` for
+    /// flat surfaces and height maps.
+    pub fn cells_per_pitch(&self, grid: &Grid) -> Option<f64> {
+        match self {
+            Surface::Lattice { pitch, .. } | Surface::Stripes { pitch, .. } => {
+                Some(pitch / grid.dx.max(grid.dy))
+            }
+            Surface::Flat | Surface::Heightmap { .. } => None,
+        }
+    }
+
+    /// What a grid that does not resolve the pattern (fewer than
+    /// [`RESOLVED_CELLS_PER_PITCH`] cells per pitch) makes of it, in one
+    /// line without the surface's name; `None` when it resolves it (and for
+    /// flat surfaces and height maps). The case is solved all the same.
+    pub fn unresolved_pattern(&self, grid: &Grid) -> Option<String> {
+        let ratio = self.cells_per_pitch(grid)?;
+        if ratio >= RESOLVED_CELLS_PER_PITCH {
+            return None;
+        }
+        let (pitch, height, what) = match self {
+            Surface::Lattice { pitch, height, .. } => (
+                *pitch,
+                *height,
+                if *height < 0.0 { "dimples" } else { "islands" },
+            ),
+            Surface::Stripes { pitch, height, .. } => (
+                *pitch,
+                *height,
+                if *height < 0.0 { "grooves" } else { "ridges" },
+            ),
+            Surface::Flat | Surface::Heightmap { .. } => return None,
+        };
+        let upper = if height <= 0.0 {
+            1.0 - self.density()
+        } else {
+            self.density()
+        };
+        let made = match self.sampling() {
+            Some(Sampling::Centre) => "centre sampling puts each cell on one level by the point at its centre alone: an aliased pattern (sampling = \"area\" gives each cell its exact cover)".to_string(),
+            _ if upper < MIN_COVER => format!(
+                "the upper level covers {upper:.3} of the surface, under the smallest cover kept ({MIN_COVER}): a cell holding many {what} lies whole at the lower level, as on a flat surface"
+            ),
+            _ => format!(
+                "each cell carries its exact cover, the fraction of its area on the upper level ({upper:.3} on average where a cell holds many {what}): a homogenised pattern"
+            ),
+        };
+        Some(format!(
+            "pitch {} µm is {} cells of {} µm, below {RESOLVED_CELLS_PER_PITCH} cells per pitch: the grid does not resolve the {what}; {made}",
+            short(pitch * 1e6),
+            short(ratio),
+            short(grid.dx.max(grid.dy) * 1e6),
+        ))
+    }
 }
+
+/// A number in four significant digits, plainly between 0.001 and 10⁴,
+/// in scientific notation otherwise.
+fn short(v: f64) -> String {
+    if (1e-3..1e4).contains(&v.abs()) {
+        let digits = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+        let text = format!("{v:.digits$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+/// Cells per pitch below which a grid does not resolve a pattern's
+/// islands, ridges or dimples: each cell then holds about a whole period or
+/// more, and the pattern acts as its mean cover per cell
+/// ([`Surface::unresolved_pattern`], `docs/physics-choices.md`).
+pub const RESOLVED_CELLS_PER_PITCH: f64 = 2.0;
 
 /// Offset of the point (x, y) from its nearest lattice site (a site at the origin).
 fn nearest_centre_offset(kind: LatticeKind, pitch: f64, x: f64, y: f64) -> (f64, f64) {
@@ -538,6 +613,155 @@ fn nearest_centre_offset(kind: LatticeKind, pitch: f64, x: f64, y: f64) -> (f64,
             }
             (best.1, best.2)
         }
+    }
+}
+
+/// The lattice's rectangular period (its supercell), the rectangle the
+/// islands repeat in along x and y: `(width, height, sites in it)`. Pitch
+/// x pitch with one site for a square lattice; pitch x √3 pitch with two
+/// for a hexagonal one (rows `√3/2` pitch apart, every other row shifted).
+fn supercell(lattice: LatticeKind, pitch: f64) -> (f64, f64, f64) {
+    match lattice {
+        LatticeKind::Square => (pitch, pitch, 1.0),
+        LatticeKind::Hexagonal => (pitch, 2.0 * (pitch * 3f64.sqrt() / 2.0), 2.0),
+    }
+}
+
+/// The circumradius of an island: how far from its site it reaches.
+fn island_reach(island: Island) -> f64 {
+    match island {
+        Island::Circle { diameter } => 0.5 * diameter,
+        Island::Square { side } => side * std::f64::consts::FRAC_1_SQRT_2,
+    }
+}
+
+/// Area of one island.
+fn island_area(island: Island) -> f64 {
+    match island {
+        Island::Circle { diameter } => std::f64::consts::PI * diameter * diameter / 4.0,
+        Island::Square { side } => side * side,
+    }
+}
+
+/// Area of the islands of a lattice inside `rect`, at a cost bounded by a
+/// handful of sites however many islands the rectangle holds (#47: a
+/// pattern far finer than the grid). Exact: the rectangle is split into
+/// `m_x x m_y` whole supercells (their islands' area in closed form), the
+/// `m_x` whole supercells' widths of the strip above them and the `m_y`
+/// heights of the column beside them (each a copy of one window at most a
+/// supercell wide and high, [`lattice_area_in`]), and the corner. A
+/// rectangle that spans no whole supercell either way is summed site by
+/// site as it is ([`lattice_area_in`], the same bits as before #47).
+fn lattice_area_tiled(
+    island: Island,
+    lattice: LatticeKind,
+    pitch: f64,
+    offset: [f64; 2],
+    reach: f64,
+    rect: &Rect,
+) -> f64 {
+    let (px, py, sites) = supercell(lattice, pitch);
+    let mx = ((rect.x1 - rect.x0) / px).floor();
+    let my = ((rect.y1 - rect.y0) / py).floor();
+    let area_in = |x0, x1, y0, y1| {
+        lattice_area_in(
+            island,
+            lattice,
+            pitch,
+            offset,
+            reach,
+            &Rect { x0, x1, y0, y1 },
+        )
+    };
+    if mx < 1.0 && my < 1.0 {
+        return area_in(rect.x0, rect.x1, rect.y0, rect.y1);
+    }
+    // The ends of the whole supercells (never past the rectangle's edge).
+    let xm = (rect.x0 + mx * px).min(rect.x1);
+    let ym = (rect.y0 + my * py).min(rect.y1);
+    let mut area = mx * my * sites * island_area(island);
+    if mx >= 1.0 {
+        area += mx * area_in(rect.x0, rect.x0 + px, ym, rect.y1);
+    }
+    if my >= 1.0 {
+        area += my * area_in(xm, rect.x1, rect.y0, rect.y0 + py);
+    }
+    area + area_in(xm, rect.x1, ym, rect.y1)
+}
+
+/// Parallel ridges: the unit normal across them, the offset of one ridge's
+/// centre line along it, their width and pitch.
+#[derive(Clone, Copy, Debug)]
+struct Ridges {
+    nx: f64,
+    ny: f64,
+    offset: f64,
+    width: f64,
+    pitch: f64,
+}
+
+impl Ridges {
+    /// Area of the ridges inside `rect` (its centre `d` across the ridges,
+    /// `spread` half its extent across them), at a cost bounded by a
+    /// handful of ridges however many the rectangle holds (#47). Exact:
+    /// the ridges repeat along x every `pitch / |nx|` and along y every
+    /// `pitch / |ny|`, and a whole period along x of any strip of height
+    /// `h` holds `width h / |nx|` of ridge (along y likewise). So the
+    /// rectangle is split into its `m_x` whole periods along x, the `m_y`
+    /// whole periods along y of the column left beside them, and the
+    /// corner, whose ridges are summed ([`Ridges::area_direct`]). A
+    /// rectangle that spans no whole period along x or y (under one pitch
+    /// across the ridges from either side) is summed as it is, the same
+    /// bits as before #47.
+    fn area_in(&self, rect: &Rect, d: f64, spread: f64) -> f64 {
+        let (ax, ay) = (self.nx.abs(), self.ny.abs());
+        let mx = ((rect.x1 - rect.x0) * ax / self.pitch).floor();
+        let my = ((rect.y1 - rect.y0) * ay / self.pitch).floor();
+        if mx < 1.0 && my < 1.0 {
+            return self.area_direct(rect, d, spread);
+        }
+        let mut area = 0.0;
+        let mut x0 = rect.x0;
+        if mx >= 1.0 {
+            area += mx * self.width * (rect.y1 - rect.y0) / ax;
+            x0 = (rect.x0 + mx * self.pitch / ax).min(rect.x1);
+        }
+        let mut y0 = rect.y0;
+        if my >= 1.0 {
+            area += my * self.width * (rect.x1 - x0) / ay;
+            y0 = (rect.y0 + my * self.pitch / ay).min(rect.y1);
+        }
+        let corner = Rect {
+            x0,
+            x1: rect.x1,
+            y0,
+            y1: rect.y1,
+        };
+        let (cx, cy) = (0.5 * (corner.x0 + corner.x1), 0.5 * (corner.y0 + corner.y1));
+        let d = self.nx * cx + self.ny * cy - self.offset;
+        let spread = 0.5 * ((corner.x1 - corner.x0) * ax + (corner.y1 - corner.y0) * ay);
+        area + self.area_direct(&corner, d, spread)
+    }
+
+    /// Area of the ridges inside `rect` (centre `d` across the ridges,
+    /// `spread` half its extent across them): every ridge that can reach
+    /// it, summed.
+    fn area_direct(&self, rect: &Rect, d: f64, spread: f64) -> f64 {
+        let Ridges {
+            nx,
+            ny,
+            offset,
+            width,
+            pitch,
+        } = *self;
+        let k0 = ((d - spread - 0.5 * width) / pitch).ceil() as i64;
+        let k1 = ((d + spread + 0.5 * width) / pitch).floor() as i64;
+        (k0..=k1)
+            .map(|k| {
+                let line = offset + k as f64 * pitch;
+                strip_in_rect(nx, ny, line, width, rect)
+            })
+            .sum()
     }
 }
 
@@ -773,6 +997,270 @@ mod tests {
                 "{k}: {u} {v}"
             );
         }
+    }
+
+    /// A small deterministic generator of uniform numbers in [0, 1).
+    struct Uniform(u64);
+
+    impl Uniform {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// #47: the cover of a cell spanning whole periods of the pattern,
+    /// integrated period by period in closed form, is the direct sum over
+    /// every island or ridge in the cell (the sum of before #47, kept as
+    /// the oracle) to round-off, at 1 to 20 periods per cell, random
+    /// positions and proportions, both lattices, circles and squares, and
+    /// ridges at several angles.
+    #[test]
+    fn issue47_tiled_cover_is_the_direct_sum_at_1_to_20_periods_per_cell() {
+        let mut rng = Uniform(47);
+        let pitch = 7.3e-6;
+        let mut worst: f64 = 0.0;
+        let mut cells = 0;
+        for lattice in [LatticeKind::Square, LatticeKind::Hexagonal] {
+            let (px, py, _) = supercell(lattice, pitch);
+            for shape in 0..2 {
+                for _ in 0..150 {
+                    // The largest island that fits: a diameter or a
+                    // diagonal of one pitch (Surface::validate).
+                    let size = (0.2 + 0.75 * rng.next()) * pitch;
+                    let island = if shape == 0 {
+                        Island::Circle { diameter: size }
+                    } else {
+                        Island::Square {
+                            side: size * std::f64::consts::FRAC_1_SQRT_2,
+                        }
+                    };
+                    let reach = island_reach(island);
+                    let offset = [(rng.next() - 0.5) * pitch, (rng.next() - 0.5) * pitch];
+                    // 1 to 20 periods one way, 0 to 20 the other.
+                    let mut span = [(1.0 + 20.0 * rng.next()).min(20.0), 20.0 * rng.next()];
+                    if rng.next() < 0.5 {
+                        span.swap(0, 1);
+                    }
+                    let (w, h) = (span[0] * px, span[1] * py);
+                    let (x0, y0) = (
+                        (rng.next() - 0.5) * 60.0 * px,
+                        (rng.next() - 0.5) * 60.0 * py,
+                    );
+                    let rect = Rect {
+                        x0,
+                        x1: x0 + w,
+                        y0,
+                        y1: y0 + h,
+                    };
+                    let tiled = lattice_area_tiled(island, lattice, pitch, offset, reach, &rect);
+                    let direct = lattice_area_in(island, lattice, pitch, offset, reach, &rect);
+                    worst = worst.max((tiled - direct).abs() / rect.area());
+                    cells += 1;
+                }
+            }
+        }
+        for angle_deg in [0.0, 17.0, 30.0, 45.0, 60.0, 90.0, 123.4, -71.0, 180.0] {
+            let (s, c) = f64::to_radians(angle_deg).sin_cos();
+            for _ in 0..150 {
+                let ridges = Ridges {
+                    nx: -s,
+                    ny: c,
+                    offset: (rng.next() - 0.5) * pitch,
+                    width: (0.05 + 0.9 * rng.next()) * pitch,
+                    pitch,
+                };
+                let (w, h) = (
+                    (0.5 + 20.0 * rng.next()) * pitch,
+                    (0.5 + 20.0 * rng.next()) * pitch,
+                );
+                let (x0, y0) = (
+                    (rng.next() - 0.5) * 60.0 * pitch,
+                    (rng.next() - 0.5) * 60.0 * pitch,
+                );
+                let rect = Rect {
+                    x0,
+                    x1: x0 + w,
+                    y0,
+                    y1: y0 + h,
+                };
+                let d = ridges.nx * 0.5 * (x0 + rect.x1) + ridges.ny * 0.5 * (y0 + rect.y1)
+                    - ridges.offset;
+                let spread = 0.5 * (w * s.abs() + h * c.abs());
+                let tiled = ridges.area_in(&rect, d, spread);
+                let direct = ridges.area_direct(&rect, d, spread);
+                worst = worst.max((tiled - direct).abs() / rect.area());
+                cells += 1;
+            }
+        }
+        println!("{cells} cells: largest |tiled - direct| / cell area = {worst:.2e}");
+        assert!(worst < 1e-12, "{worst:e}");
+    }
+
+    /// #47: a pattern a million times finer than the grid (10¹² islands
+    /// per cell) costs a handful of sites per cell: every cell's cover is
+    /// the pattern's density to within one period's share of the cell,
+    /// the cells add up to the whole domain's area integrated at once, and
+    /// the mean cover over the grid is the density to within the
+    /// domain's part-period border (a whole number of periods: to 1e-9).
+    #[test]
+    fn issue47_a_pattern_a_million_times_finer_than_the_grid_has_its_density_as_cover() {
+        let cell = 1.7e-6;
+        let pitch = 1e-6 * cell;
+        let grid = Grid::square(48, cell);
+        let lattice = |island, lattice, height| Surface::Lattice {
+            island,
+            pitch,
+            height,
+            offset: [0.31 * pitch, -0.17 * pitch],
+            lattice,
+            sampling: Sampling::Area,
+        };
+        let stripes = |angle_deg| Surface::Stripes {
+            width: 0.37 * pitch,
+            pitch,
+            height: 1e-6,
+            angle_deg,
+            offset: 0.21 * pitch,
+            sampling: Sampling::Area,
+        };
+        let circle = Island::Circle {
+            diameter: 0.6 * pitch,
+        };
+        let square = Island::Square { side: 0.5 * pitch };
+        let surfaces = [
+            lattice(circle, LatticeKind::Square, 1e-6),
+            lattice(square, LatticeKind::Square, -1e-6),
+            lattice(circle, LatticeKind::Hexagonal, 1e-6),
+            lattice(square, LatticeKind::Hexagonal, 1e-6),
+            stripes(0.0),
+            stripes(90.0),
+            stripes(30.0),
+            stripes(-47.0),
+        ];
+        let side = grid.n as f64 * cell;
+        let domain = Rect::square(0.0, 0.0, side);
+        for s in &surfaces {
+            s.validate(grid.n).unwrap();
+            let f = s.raised_fraction(&grid);
+            let rho = s.density();
+            let whole = match s {
+                Surface::Lattice {
+                    island,
+                    lattice,
+                    offset,
+                    ..
+                } => {
+                    let reach = island_reach(*island);
+                    lattice_area_tiled(*island, *lattice, pitch, *offset, reach, &domain)
+                }
+                Surface::Stripes {
+                    width,
+                    angle_deg,
+                    offset,
+                    ..
+                } => {
+                    let (sn, cs) = angle_deg.to_radians().sin_cos();
+                    let ridges = Ridges {
+                        nx: -sn,
+                        ny: cs,
+                        offset: *offset,
+                        width: *width,
+                        pitch,
+                    };
+                    ridges.area_in(&domain, -ridges.offset, 0.5 * side * (sn.abs() + cs.abs()))
+                }
+                _ => unreachable!(),
+            } / domain.area();
+            let mean = f.iter().sum::<f64>() / grid.len() as f64;
+            let spread = f.iter().fold(0.0f64, |m, v| m.max((v - rho).abs()));
+            let (px, py) = match s {
+                Surface::Lattice { lattice, .. } => {
+                    let (px, py, _) = supercell(*lattice, pitch);
+                    (px, py)
+                }
+                _ => (pitch, pitch),
+            };
+            println!(
+                "{s:?}\n  density {rho:.12}, mean cover {mean:.12} ({:.1e}), whole domain {:.1e}, cells within {spread:.1e}",
+                mean / rho - 1.0,
+                mean / whole - 1.0
+            );
+            assert!(
+                (mean / whole - 1.0).abs() < 1e-12,
+                "additivity: {mean} {whole}"
+            );
+            assert!(spread < 4.0 * (px + py) / cell, "{spread:e}");
+            let border = 2.0 * (px + py) / side;
+            assert!(
+                (mean / rho - 1.0).abs() < border.max(1e-9),
+                "{mean} vs {rho}"
+            );
+        }
+        // A whole number of periods: the mean is the density to 1e-9.
+        let exact = Surface::Lattice {
+            island: circle,
+            pitch: cell / 1048576.0,
+            height: 1e-6,
+            offset: [0.0, 0.0],
+            lattice: LatticeKind::Square,
+            sampling: Sampling::Area,
+        };
+        let f = exact.raised_fraction(&grid);
+        let mean = f.iter().sum::<f64>() / grid.len() as f64;
+        println!(
+            "2^20 periods per cell: mean / density - 1 = {:.1e}",
+            mean / exact.density() - 1.0
+        );
+        assert!((mean / exact.density() - 1.0).abs() < 1e-9);
+        // The heights and the cover of such a pattern: raised cells, each
+        // cut to the density.
+        let t = surfaces[0].terrain(&grid);
+        assert!(t.heights.iter().all(|&h| h == 1e-6));
+        let cover = t.cover.unwrap();
+        assert!(cover
+            .iter()
+            .all(|c| (c - surfaces[0].density()).abs() < 1e-6));
+    }
+
+    /// #47: a grid with fewer than two cells per pitch is told apart from
+    /// the paper's patterns (many cells per pitch), and the note names the
+    /// pitch, the ratio, the cell and what the sampling makes of it.
+    #[test]
+    fn issue47_an_unresolved_pattern_is_named_with_its_ratio() {
+        let grid = Grid::square(128, 2e-6);
+        for (name, s) in crate::model::presets::surfaces() {
+            assert_eq!(s.unresolved_pattern(&grid), None, "{name}");
+        }
+        let fine = Surface::Lattice {
+            island: Island::Circle { diameter: 1e-12 },
+            pitch: 2e-12,
+            height: 1e-6,
+            offset: [0.0, 0.0],
+            lattice: LatticeKind::Square,
+            sampling: Sampling::Area,
+        };
+        assert_eq!(fine.cells_per_pitch(&grid), Some(1e-6));
+        let note = fine.unresolved_pattern(&grid).unwrap();
+        println!("{note}");
+        assert!(
+            note.contains("pitch 2.000e-6 µm is 1.000e-6 cells of 2 µm")
+                && note.contains("0.196 on average")
+                && note.contains("islands"),
+            "{note}"
+        );
+        let mut centre = fine.clone();
+        if let Surface::Lattice { sampling, .. } = &mut centre {
+            *sampling = Sampling::Centre;
+        }
+        assert!(centre
+            .unresolved_pattern(&grid)
+            .unwrap()
+            .contains("aliased"));
+        assert_eq!(Surface::Flat.unresolved_pattern(&grid), None);
     }
 
     #[test]
