@@ -6,7 +6,8 @@
 //! `protocol`.
 //! A case is named by one typed key (`case::CaseKey`) everywhere.
 //!
-//! Layers, each importing only from itself and those before it: foundations
+//! Layers, each importing only from itself and those before it (checked by
+//! `tests/layers.rs`, which lists the modules in order): foundations
 //! (`case`, `convergence`, `float_text`, `solve_progress`) → `config` →
 //! `memory`, `cost`, `output` → `solve`, `dry_run`, `shard` → `run`.
 
