@@ -103,12 +103,12 @@ pub struct ResultHeader<K, R> {
     pub grid_n: u32,
     /// Wall time of the solve in the worker, s.
     pub solve_seconds: f64,
-    /// Kernels (operators) this worker has built so far in this run.
-    pub kernel_builds: u64,
-    /// Of those, how many it loaded from the kernel store (stored by
+    /// Kernels (operators) this worker has computed so far in this run.
+    pub kernels_built: u64,
+    /// Kernels it has loaded from the kernel store so far (stored by
     /// another worker or an earlier run) instead of computing them.
     #[serde(default)]
-    pub kernel_loads: u64,
+    pub kernels_loaded: u64,
     /// Distinct (material, grid) kernels resident in this worker.
     pub kernels_resident: u64,
     /// Nanoseconds since the Unix epoch when the result was ready to send
@@ -131,8 +131,8 @@ pub struct Failure<K> {
     pub error: String,
     /// Wall time until the failure, s.
     pub solve_seconds: f64,
-    /// Kernels built so far.
-    pub kernel_builds: u64,
+    /// Kernels this worker has computed so far.
+    pub kernels_built: u64,
 }
 
 /// Result scalars that can be checked for NaN/∞ before they are recorded.

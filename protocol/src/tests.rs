@@ -14,8 +14,8 @@ fn result_header(n: u32, fields: bool) -> ResultHeader<String, Scalars> {
         worker_index: 1,
         grid_n: n,
         solve_seconds: 0.5,
-        kernel_builds: 1,
-        kernel_loads: 0,
+        kernels_built: 1,
+        kernels_loaded: 0,
         kernels_resident: 1,
         sent_unix_ns: 42,
         field_names: if fields {

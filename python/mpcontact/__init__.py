@@ -145,6 +145,9 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
         name = None
     if angle_deg is not None:
         angle_deg = float(angle_deg)
+    if name is not None or heights is None:
+        surfaces = [name] if name is not None else cfg.surfaces[:1]
+        _warn_unresolved(cfg, surfaces)
     scalars, fields, stress = _native.solve(
         cfg,
         material=material,
@@ -247,6 +250,7 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
     if out is None:
         out = tempfile.mkdtemp(prefix="mpcontact-run-")
     out = Path(out)
+    _warn_unresolved(cfg, None)
     program, args = _worker_command()
     summary = _native.run(
         cfg, int(workers), str(out), bool(resume), not progress, bool(save_fields), program, args
@@ -260,6 +264,15 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
         fretting_transitions=_read_csv_if(out / "fretting_transitions.csv"),
         orientations=_read_csv_if(out / "orientations.csv"),
     )
+
+
+def _warn_unresolved(cfg, surfaces):
+    """Warns, as the CLI does on stderr, of each pattern among ``surfaces``
+    (default: the sweep's) that the grid does not resolve."""
+    import warnings
+
+    for text in cfg.unresolved_patterns(surfaces):
+        warnings.warn(text, UserWarning, stacklevel=3)
 
 
 def _worker_command():

@@ -203,6 +203,17 @@ impl PyConfig {
         self.config.sweep.surfaces.clone()
     }
 
+    /// The warnings `mpcontact check`, `solve` and `run` print for the
+    /// patterns among `surfaces` (default: `sweep.surfaces`) whose pitch the
+    /// grid does not resolve (below 2 cells per pitch).
+    #[pyo3(signature = (surfaces=None))]
+    fn unresolved_patterns(&self, surfaces: Option<Vec<String>>) -> PyResult<Vec<String>> {
+        let surfaces = surfaces.unwrap_or_else(|| self.config.sweep.surfaces.clone());
+        self.config
+            .unresolved_patterns(&surfaces)
+            .map_err(value_error)
+    }
+
     /// `sweep.angles_deg`, expanded.
     #[getter]
     fn angles_deg(&self) -> PyResult<Vec<f64>> {

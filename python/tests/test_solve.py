@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import mpcontact
-from conftest import mindlin_text, pattern_text
+from conftest import REPO, mindlin_text, pattern_text
 
 # Wall-clock times: the only keys of case.json that differ between two
 # identical solves.
@@ -288,3 +288,29 @@ def test_stress_below_the_surface_equals_the_cli_bit_for_bit(tmp_path, cli_solve
     plain = tmp_path / "plain.toml"
     plain.write_text(mindlin_text(ratio=0.6))
     assert mpcontact.solve(mpcontact.Config.from_toml(plain)).stress is None
+
+
+def test_a_pattern_finer_than_the_grid_is_solved_with_the_clis_warning(tmp_path):
+    # Issue #47: a circle lattice whose pitch is 10⁻⁶ of a cell; its cover
+    # costs a few islands a cell, and Python warns as the CLI prints.
+    text = (REPO / "tests" / "configs" / "table1c-coarse.toml").read_text() + """
+[surfaces.fine]
+shape = "circle"
+diameter_um = 1.2e-4
+pitch_um = 2.0e-4
+height_um = 1.0
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["fine"]
+angles_deg = [0.0]
+"""
+    path = tmp_path / "fine.toml"
+    path.write_text(text)
+    cfg = mpcontact.Config.from_toml(path)
+    (warning,) = cfg.unresolved_patterns()
+    assert "surface `fine`" in warning and "below 2 cells per pitch" in warning
+    assert cfg.unresolved_patterns(["flat"]) == []
+    with pytest.warns(UserWarning, match="below 2 cells per pitch"):
+        r = mpcontact.solve(cfg)
+    assert r.scalars["converged"]

@@ -258,8 +258,8 @@ fn solve_one<K: WireKey>(
                 worker_index: worker_index as u32,
                 grid_n: case.grid_n,
                 solve_seconds,
-                kernel_builds: (cache.builds() + cache.loads()) as u64,
-                kernel_loads: cache.loads() as u64,
+                kernels_built: cache.builds() as u64,
+                kernels_loaded: cache.loads() as u64,
                 kernels_resident: keys.len() as u64,
                 sent_unix_ns: 0,
                 field_names: if want {
@@ -277,7 +277,7 @@ fn solve_one<K: WireKey>(
                 worker_index: worker_index as u32,
                 error: e.to_string(),
                 solve_seconds,
-                kernel_builds: (cache.builds() + cache.loads()) as u64,
+                kernels_built: cache.builds() as u64,
             }),
             None,
         ),
@@ -520,7 +520,7 @@ mod tests {
                 ToCoord::Result(h) => {
                     assert_eq!(h.worker_index, 3);
                     assert!(h.field_names.is_empty());
-                    builds.push((h.kernel_builds, h.kernels_resident));
+                    builds.push((h.kernels_built, h.kernels_resident));
                 }
                 other => panic!("{id}: {other:?}"),
             }

@@ -214,7 +214,7 @@ impl<'a> Dispatch<'a> {
         f: Failure<CaseKey>,
     ) -> anyhow::Result<()> {
         if let Some(i) = rec.plan().index_of(&f.key) {
-            let outcome = Outcome::failed(f.error, worker, f.solve_seconds, f.kernel_builds);
+            let outcome = Outcome::failed(f.error, worker, f.solve_seconds, f.kernels_built);
             self.record(rec, i, worker, outcome)?;
         }
         Ok(())
@@ -259,7 +259,7 @@ impl<'a> Dispatch<'a> {
             let mine = rec.plan().in_flight(i).is_some_and(|(w, _)| w == worker);
             if mine && (deterministic || case.attempts >= MAX_ATTEMPTS) {
                 let error = format!("invalid result: {e}");
-                let outcome = Outcome::failed(error, worker, h.solve_seconds, h.kernel_builds);
+                let outcome = Outcome::failed(error, worker, h.solve_seconds, h.kernels_built);
                 self.record(rec, i, worker, outcome)?;
             } else if mine {
                 rec.requeue(i);
@@ -289,14 +289,14 @@ impl<'a> Dispatch<'a> {
             }
         }
         if let Some(peer) = self.peers.get_mut(&worker) {
-            peer.stats.kernel_loads = peer.stats.kernel_loads.max(h.kernel_loads);
+            peer.stats.kernels_loaded = peer.stats.kernels_loaded.max(h.kernels_loaded);
         }
         let outcome = Outcome {
             status: Status::of_solved(h.scalars.0.converged),
             error: None,
             worker: worker as u32,
             seconds: h.solve_seconds,
-            kernel_builds: h.kernel_builds,
+            kernel_builds: h.kernels_built,
             scalars: Some(h.scalars.0),
             stress: h.scalars.1,
         };
@@ -320,7 +320,7 @@ impl<'a> Dispatch<'a> {
         let r = &done.outcome;
         if let Some(peer) = self.peers.get_mut(&worker) {
             peer.stats.cases += 1;
-            peer.stats.kernel_builds = peer.stats.kernel_builds.max(r.kernel_builds);
+            peer.stats.kernels_built = peer.stats.kernels_built.max(r.kernel_builds);
         }
         let line = format!(
             "{} {} by worker {} in {:.2} s",

@@ -28,7 +28,9 @@ pub struct Outcome {
     pub worker: u32,
     /// Solve wall time in the worker, s.
     pub seconds: f64,
-    /// Kernels the worker had built when it sent this.
+    /// Kernels the worker had computed itself when it sent this (the
+    /// wire's `kernels_built`; in journals written before issue #47, the
+    /// kernels it had made resident, loads included).
     pub kernel_builds: u64,
     /// Scalars as computed by the worker (μa before K_E calibration).
     pub scalars: Option<CaseScalars>,

@@ -18,22 +18,22 @@ use crate::case::Status;
 pub struct WorkerSummary {
     /// Cases this worker recorded.
     pub cases: u64,
-    /// Kernels (operators) it made resident, built or loaded: the wire's
-    /// `kernel_builds` (`KernelCache::builds()`), once per (material, grid).
-    pub kernel_builds: u64,
-    /// Of those, how many it loaded from the kernel store (built by another
-    /// worker, which it waited for, or by an earlier run) instead of computing.
-    pub kernel_loads: u64,
+    /// Kernels (operators) it computed itself: the wire's `kernels_built`
+    /// (`KernelCache::builds()`), once per (material, grid).
+    pub kernels_built: u64,
+    /// Kernels it loaded from the kernel store (built by another worker,
+    /// which it waited for, or by an earlier run) instead of computing them:
+    /// the wire's `kernels_loaded` (`KernelCache::loads()`).
+    pub kernels_loaded: u64,
     /// It died (or was lost) during the run.
     pub died: bool,
 }
 
 impl WorkerSummary {
-    /// Kernels this worker computed itself (resident and not loaded).
-    pub fn kernels_built(&self) -> u64 {
-        // Both counts are maxima over the worker's messages; a load seen in
-        // a result that was not recorded (a duplicate) must not wrap this.
-        self.kernel_builds.saturating_sub(self.kernel_loads)
+    /// The deprecated `kernel_builds` of `summary.json`: the kernels this
+    /// worker made resident, computed or loaded.
+    pub fn kernels_resident(&self) -> u64 {
+        self.kernels_built + self.kernels_loaded
     }
 }
 
@@ -61,10 +61,10 @@ impl From<WorkerSummary> for WorkerReport {
     fn from(w: WorkerSummary) -> Self {
         WorkerReport {
             cases: w.cases,
-            kernels_built: w.kernels_built(),
-            kernels_loaded: w.kernel_loads,
-            kernel_builds: w.kernel_builds,
-            kernel_loads: w.kernel_loads,
+            kernels_built: w.kernels_built,
+            kernels_loaded: w.kernels_loaded,
+            kernel_builds: w.kernels_resident(),
+            kernel_loads: w.kernels_loaded,
             died: w.died,
         }
     }
@@ -159,12 +159,12 @@ impl RunSummary {
     /// The kernel counts of the whole run, from `per_worker`.
     pub fn count_kernels(&mut self) {
         let workers = self.per_worker.values();
-        self.kernels_built = workers.clone().map(WorkerSummary::kernels_built).sum();
-        self.kernels_loaded = workers.map(|w| w.kernel_loads).sum();
+        self.kernels_built = workers.clone().map(|w| w.kernels_built).sum();
+        self.kernels_loaded = workers.map(|w| w.kernels_loaded).sum();
         self.kernel_builds = self
             .per_worker
             .iter()
-            .map(|(k, w)| (k.clone(), w.kernel_builds))
+            .map(|(k, w)| (k.clone(), w.kernels_resident()))
             .collect();
     }
 
@@ -249,13 +249,12 @@ mod tests {
     use worker::kernel_store::FileStore;
 
     /// A worker's statistics as `dispatch` takes them from its results,
-    /// whose counts are the worker's kernels made resident (its
-    /// `KernelCache::builds() + loads()`) and `loads()`.
+    /// whose counts are the worker's `KernelCache::builds()` and `loads()`.
     fn seen_by_dispatch(cache: &KernelCache) -> WorkerSummary {
         WorkerSummary {
             cases: 1,
-            kernel_builds: (cache.builds() + cache.loads()) as u64,
-            kernel_loads: cache.loads() as u64,
+            kernels_built: cache.builds() as u64,
+            kernels_loaded: cache.loads() as u64,
             died: false,
         }
     }
