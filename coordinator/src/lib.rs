@@ -7,8 +7,9 @@
 //! A case is named by one typed key (`case::CaseKey`) everywhere.
 //!
 //! Layers, each importing only from itself and those before it (checked by
-//! `tests/layers.rs`, which lists the modules in order): foundations
-//! (`case`, `convergence`, `float_text`, `solve_progress`) → `config` →
+//! the workspace's `tests/tests/layers.rs`, which lists the modules in
+//! order): foundations (`case`, `convergence`, `float_text`,
+//! `solve_progress`) → `config` →
 //! `memory`, `cost`, `output` → `solve`, `dry_run`, `shard` → `run`.
 
 pub mod case;

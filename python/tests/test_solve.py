@@ -291,15 +291,11 @@ def test_stress_below_the_surface_equals_the_cli_bit_for_bit(tmp_path, cli_solve
 
 
 def test_a_pattern_finer_than_the_grid_is_solved_with_the_clis_warning(tmp_path):
-    # Issue #47: a circle lattice whose pitch is 10⁻⁶ of a cell; its cover
+    # Issue #47: a circle lattice whose pitch is 3e-7 of a cell; its cover
     # costs a few islands a cell, and Python warns as the CLI prints.
-    text = (REPO / "tests" / "configs" / "table1c-coarse.toml").read_text() + """
-[surfaces.fine]
-shape = "circle"
-diameter_um = 1.2e-4
-pitch_um = 2.0e-4
-height_um = 1.0
-
+    configs = REPO / "tests" / "configs"
+    text = (configs / "table1c-coarse.toml").read_text()
+    text += (configs / "fine-circles.toml").read_text() + """
 [sweep]
 materials = ["Cu"]
 surfaces = ["fine"]

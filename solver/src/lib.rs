@@ -62,7 +62,8 @@
 //!    `stress_summary` (a case's stresses and their scalars), `indentation`
 //! 7. `case`, the driver (`solve_case`)
 //!
-//! `solver/tests/layers.rs` checks the order and the absence of circles.
+//! The workspace's `tests/tests/layers.rs` checks the order and the absence
+//! of circles.
 
 mod base;
 mod case;

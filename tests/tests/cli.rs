@@ -2,32 +2,8 @@
 //! `solve` outputs and its progress line, clear errors for bad input (never
 //! a panic), `kernel` JSON.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-/// The `mpcontact` binary of the same build. `cargo test --workspace` builds it
-/// (the coordinator's own integration tests need it).
-fn exe() -> PathBuf {
-    let mut p = std::env::current_exe().unwrap();
-    p.pop();
-    if p.ends_with("deps") {
-        p.pop();
-    }
-    let exe = p.join("mpcontact");
-    assert!(
-        exe.exists(),
-        "{} not built: run `cargo test --workspace`",
-        exe.display()
-    );
-    exe
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(exe())
-        .args(args)
-        .output()
-        .expect("run mpcontact")
-}
+use mpcontact_e2e::{exe, run};
+use std::process::Command;
 
 fn temp_dir(name: &str) -> tempfile::TempDir {
     // Removed when dropped: the tests leave nothing in the system temp dir.

@@ -4,32 +4,12 @@
 //! case is solved on the pattern's exact mean cover, and `solve` and
 //! `check` say that the grid does not resolve the islands.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-/// The `mpcontact` binary of the same build (`cargo test --workspace`
-/// builds it; alone, `cargo build --release --bin mpcontact` first).
-fn exe() -> PathBuf {
-    let mut p = std::env::current_exe().unwrap();
-    p.pop();
-    if p.ends_with("deps") {
-        p.pop();
-    }
-    let exe = p.join("mpcontact");
-    assert!(exe.exists(), "{} not built", exe.display());
-    exe
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(exe())
-        .args(args)
-        .output()
-        .expect("run mpcontact")
-}
+use mpcontact_e2e::run;
 
 /// 128² cells of 60 µm (the quick sweep's grid) under a circle lattice of
 /// pitch 6e-5 µm: 10⁻⁶ cells per pitch.
-const FINE: &str = r#"
+const FINE: &str = concat!(
+    r#"
 [grid]
 points = 128
 spacing_um = 60.0
@@ -42,17 +22,15 @@ normal_n = 6000.0
 friction = 0.3
 tangential_ratio = 0.6
 
-[surfaces.fine]
-shape = "circle"
-diameter_um = 3.6e-5
-pitch_um = 6.0e-5
-height_um = 1.0
-
+"#,
+    include_str!("../configs/fine-circles.toml"),
+    r#"
 [sweep]
 materials = ["Cu"]
 surfaces = ["fine"]
 angles_deg = [0.0, 45.0]
-"#;
+"#
+);
 
 const WARNING: &str =
     "surface `fine`: pitch 6.000e-5 µm is 1.000e-6 cells of 60 µm, below 2 cells per pitch";

@@ -4,7 +4,7 @@
 //! imports: a sweep's cases reach it as plain [`sweep::Row`]s.
 //!
 //! Its modules import only the ones listed before them (no circles;
-//! `coordinator/tests/layers.rs` checks it from the sources):
+//! `tests/tests/layers.rs` checks it from the sources):
 //! `atomic` (every file whole or not at all) → `npy` (arrays) → `plot` (one
 //! figure on PNG or SVG, frames, colours, the colour bar) → `maps` (field
 //! maps of a case, [`maps::Heat`]) → `history` (a load history's table and
