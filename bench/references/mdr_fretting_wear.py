@@ -182,7 +182,7 @@ class CycleRecord:
     h: np.ndarray            # worn depth h(r) [m]
     volume: float            # worn volume [m^3]
     max_depth: float
-    a: float                 # contact radius at the cycle's end
+    a: float                 # contact radius at the cycle's end: edge of {w > 0} (the scar's edge once worn)
     c: float                 # stick radius at the +A turning point
     F_amp: float             # tangential force amplitude (max-min)/2
     d_amp: float             # displacement amplitude (max-min)/2
@@ -262,6 +262,8 @@ class MDRContact:
         self.L = S.mu * (S.Estar / S.Gstar) * self.w_nodes          # slip limits |u| <= L
         self.qw = 2.0 * line_weights(X)[is_node]                    # int over -x..x of node values
         pos = np.nonzero(W > 0)[0]
+        if pos.size and X[pos[-1]] >= self.r[-1]:
+            raise ValueError("the contact reaches the grid's edge r = %.4g m: raise rmax_over_a" % self.r[-1])
         # the contact edge is the breakpoint after the last positive one (a root)
         self.a = float(X[min(pos[-1] + 1, X.size - 1)]) if pos.size else 0.0
         # a spring leaving contact carries nothing; one whose limit shrank slips
@@ -817,7 +819,8 @@ def main(argv=None):
     g.add_argument("--jump", choices=("increment", "block"), default="increment")
     g.add_argument("--save-every", type=int, default=1)
     g.add_argument("--nodes", type=int, default=400)
-    g.add_argument("--rmax-over-a", type=float, default=1.25)
+    g.add_argument("--rmax-over-a", type=float, default=1.5,
+                   help="grid extent / Hertz radius (the scar can outgrow a_Hertz: 1.18 a in the checks' partial-slip runs)")
     g.add_argument("--csv", default=None, help="write r, h(r) per saved cycle and the final p(r)")
     a = ap.parse_args(argv)
     t0 = time.time()
