@@ -429,7 +429,6 @@ def fretting(setup: Setup, amplitude, control="force", cycles=1, N=20,
     recs = []
     phys = 0.0
     for cyc in range(cycles):
-        V0 = float(m.area_w @ m.h)
         e1 = e3 = 0.0
         Qs, ds_, cA, gross = [], [], None, False
         dh_cyc = np.zeros_like(m.r)
@@ -583,7 +582,6 @@ def check_mindlin(ch, S, label, N=20):
     ch.cond("%s 3-D u_x = delta in the stick zone" % label, e < 1e-9, "%.1e" % e)
     # unloading to Q = 0 and on to -Q*
     Qp = np.concatenate([Qs - 2 * Qs * np.arange(1, 2 * N + 1) / (2 * N)])
-    W = 0.0
     qd = [(m.delta, m.Q())]
     for t in Qp:
         o = m.step(t, "force")
@@ -654,7 +652,6 @@ def run_ciavarella_hills(S, cycles=60, M=None, N=10, verbose=True, frac=0.6):
         pch = ciavarella_hills(S, c0, m.r)
         fin = np.isfinite(pch)
         dist = float(m.area_w[fin] @ np.abs(p[fin] - pch[fin])) / S.P
-        ann = (m.r > recs[-1].c) & (m.r < m.a)
         pan = float(m.area_w[m.r > c0] @ np.maximum(p[m.r > c0], 0)) / S.P
         rows.append((mk, recs[-1].c / c0, pan, dist, recs[-1].max_depth / d0, recs[-1].regime))
         if verbose:
