@@ -1010,6 +1010,19 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (self.0 >> 11) as f64 / (1u64 << 53) as f64
         }
+
+        /// A `w × h` rectangle whose corner lies anywhere within 30 periods
+        /// `(px, py)` of the origin either way.
+        fn rect(&mut self, w: f64, h: f64, (px, py): (f64, f64)) -> Rect {
+            let x0 = (self.next() - 0.5) * 60.0 * px;
+            let y0 = (self.next() - 0.5) * 60.0 * py;
+            Rect {
+                x0,
+                x1: x0 + w,
+                y0,
+                y1: y0 + h,
+            }
+        }
     }
 
     /// #47: the cover of a cell spanning whole periods of the pattern,
@@ -1045,17 +1058,7 @@ mod tests {
                     if rng.next() < 0.5 {
                         span.swap(0, 1);
                     }
-                    let (w, h) = (span[0] * px, span[1] * py);
-                    let (x0, y0) = (
-                        (rng.next() - 0.5) * 60.0 * px,
-                        (rng.next() - 0.5) * 60.0 * py,
-                    );
-                    let rect = Rect {
-                        x0,
-                        x1: x0 + w,
-                        y0,
-                        y1: y0 + h,
-                    };
+                    let rect = rng.rect(span[0] * px, span[1] * py, (px, py));
                     let tiled = lattice_area_tiled(island, lattice, pitch, offset, reach, &rect);
                     let direct = lattice_area_in(island, lattice, pitch, offset, reach, &rect);
                     worst = worst.max((tiled - direct).abs() / rect.area());
@@ -1077,17 +1080,9 @@ mod tests {
                     (0.5 + 20.0 * rng.next()) * pitch,
                     (0.5 + 20.0 * rng.next()) * pitch,
                 );
-                let (x0, y0) = (
-                    (rng.next() - 0.5) * 60.0 * pitch,
-                    (rng.next() - 0.5) * 60.0 * pitch,
-                );
-                let rect = Rect {
-                    x0,
-                    x1: x0 + w,
-                    y0,
-                    y1: y0 + h,
-                };
-                let d = ridges.nx * 0.5 * (x0 + rect.x1) + ridges.ny * 0.5 * (y0 + rect.y1)
+                let rect = rng.rect(w, h, (pitch, pitch));
+                let d = ridges.nx * 0.5 * (rect.x0 + rect.x1)
+                    + ridges.ny * 0.5 * (rect.y0 + rect.y1)
                     - ridges.offset;
                 let spread = 0.5 * (w * s.abs() + h * c.abs());
                 let tiled = ridges.area_in(&rect, d, spread);
