@@ -286,13 +286,6 @@ fn real_main() -> Result<ExitCode> {
             quiet,
         } => {
             let cfg = Config::load(&config, &sets)?;
-            // The surface solved: the one named, else the sweep's first.
-            let chosen = surface
-                .clone()
-                .map_or_else(|| cfg.sweep.surfaces[..1].to_vec(), |s| vec![s]);
-            for w in cfg.unresolved_patterns(&chosen)? {
-                eprintln!("warning: {w}");
-            }
             let threads = threads.map_or_else(solver::Threads::available, |n| n.get());
             let s = coordinator::solve::run_solve(
                 &cfg,

@@ -102,6 +102,14 @@ pub struct CaseChoice {
 }
 
 impl CaseChoice {
+    /// The warning `check`, `solve` and `run` give when the grid does not
+    /// resolve this case's pattern (`surface `NAME`: …`, see
+    /// [`Config::unresolved_patterns`]); `None` when it does.
+    pub fn unresolved_pattern(&self) -> Option<String> {
+        let w = self.spec.surface.unresolved_pattern(&self.spec.grid)?;
+        Some(format!("surface `{}`: {w}", self.surface))
+    }
+
     /// The case `material` × `surface` × `angle_deg` of `config`; each
     /// defaults to the sweep's first. Errors name config keys.
     pub fn new(
@@ -315,6 +323,9 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     let mut case = CaseChoice::new(config, args.material, args.surface, args.angle_deg)?;
     if let Some(name) = args.indenter {
         case = case.with_indenter(config, "--indenter", name)?;
+    }
+    if let Some(w) = case.unresolved_pattern() {
+        eprintln!("warning: {w}");
     }
     let label = format!("{}/{}/{}°", case.material, case.surface, case.angle_deg);
     let progress = SolveProgress::start(args.quiet, &label);

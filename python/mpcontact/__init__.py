@@ -145,9 +145,6 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
         name = None
     if angle_deg is not None:
         angle_deg = float(angle_deg)
-    if name is not None or heights is None:
-        surfaces = [name] if name is not None else cfg.surfaces[:1]
-        _warn_unresolved(cfg, surfaces)
     scalars, fields, stress = _native.solve(
         cfg,
         material=material,
@@ -250,7 +247,7 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
     if out is None:
         out = tempfile.mkdtemp(prefix="mpcontact-run-")
     out = Path(out)
-    _warn_unresolved(cfg, None)
+    _warn_unresolved(cfg)
     program, args = _worker_command()
     summary = _native.run(
         cfg, int(workers), str(out), bool(resume), not progress, bool(save_fields), program, args
@@ -266,12 +263,12 @@ def run(cfg, workers=2, out=None, resume=False, progress=True, save_fields=False
     )
 
 
-def _warn_unresolved(cfg, surfaces):
-    """Warns, as the CLI does on stderr, of each pattern among ``surfaces``
-    (default: the sweep's) that the grid does not resolve."""
+def _warn_unresolved(cfg):
+    """Warns, as ``mpcontact run`` does on stderr, of each pattern of the
+    sweep that the grid does not resolve."""
     import warnings
 
-    for text in cfg.unresolved_patterns(surfaces):
+    for text in cfg.unresolved_patterns():
         warnings.warn(text, UserWarning, stacklevel=3)
 
 

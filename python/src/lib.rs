@@ -421,6 +421,13 @@ fn solve<'py>(
         None => Ok(case),
     })
     .map_err(value_error)?;
+    if let Some(w) = case.unresolved_pattern() {
+        // What the CLI prints on stderr, as a Python warning (stack level
+        // 2: the caller of `mpcontact.solve`).
+        let text = std::ffi::CString::new(w).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        PyErr::warn(py, &category, &text, 2)?;
+    }
     let solved = interruptible(py, move || {
         solve_in_memory(case, solver::Threads::available())
     })?
