@@ -402,7 +402,7 @@ impl Surface {
     /// (closed-form areas of [`crate::base::cover`]), row-major; zeros for flat
     /// surfaces and height maps. A cell costs a handful of islands or
     /// ridges however fine the pattern (whole periods in closed form,
-    /// [`lattice_area_tiled`], [`Ridges::area_in`]; #47).
+    /// [`Sites::area_in`], [`Ridges::area_in`]; #47).
     pub fn raised_fraction(&self, grid: &Grid) -> Vec<f64> {
         let n = grid.n;
         let mut f = vec![0.0; grid.len()];
@@ -453,7 +453,7 @@ impl Surface {
                 lattice,
                 ..
             } => {
-                let reach = island_reach(*island);
+                let sites = Sites::new(*island, *lattice, *pitch, *offset);
                 for iy in 0..n {
                     for ix in 0..n {
                         let (x, y) = (grid.x(ix), grid.y(iy));
@@ -472,12 +472,9 @@ impl Surface {
                         let cell = &mut f[iy * n + ix];
                         if inside {
                             *cell = 1.0;
-                        } else if u.hypot(v) - half_diagonal < reach {
+                        } else if u.hypot(v) - half_diagonal < sites.reach {
                             let rect = Rect::cell(x, y, dx, dy);
-                            let area = lattice_area_tiled(
-                                *island, *lattice, *pitch, *offset, reach, &rect,
-                            );
-                            *cell = (area / rect.area()).min(1.0);
+                            *cell = (sites.area_in(&rect) / rect.area()).min(1.0);
                         }
                     }
                 }
@@ -643,50 +640,92 @@ fn island_area(island: Island) -> f64 {
     }
 }
 
-/// Area of the islands of a lattice inside `rect`, at a cost bounded by a
-/// handful of sites however many islands the rectangle holds (#47: a
-/// pattern far finer than the grid). Exact: the rectangle is split into
-/// `m_x x m_y` whole supercells (their islands' area in closed form), the
-/// `m_x` whole supercells' widths of the strip above them and the `m_y`
-/// heights of the column beside them (each a copy of one window at most a
-/// supercell wide and high, [`lattice_area_in`]), and the corner. A
-/// rectangle that spans no whole supercell either way is summed site by
-/// site as it is ([`lattice_area_in`], the same bits as before #47).
-fn lattice_area_tiled(
+/// The islands of a lattice: their shape, the lattice, its pitch and the
+/// offset of one site, and how far an island reaches from its site (its
+/// circumradius).
+#[derive(Clone, Copy, Debug)]
+struct Sites {
     island: Island,
     lattice: LatticeKind,
     pitch: f64,
     offset: [f64; 2],
     reach: f64,
-    rect: &Rect,
-) -> f64 {
-    let (px, py, sites) = supercell(lattice, pitch);
-    let mx = ((rect.x1 - rect.x0) / px).floor();
-    let my = ((rect.y1 - rect.y0) / py).floor();
-    let area_in = |x0, x1, y0, y1| {
-        lattice_area_in(
+}
+
+impl Sites {
+    fn new(island: Island, lattice: LatticeKind, pitch: f64, offset: [f64; 2]) -> Self {
+        Sites {
+            island,
+            lattice,
+            pitch,
+            offset,
+            reach: island_reach(island),
+        }
+    }
+
+    /// Area of the islands inside `rect`, at a cost bounded by a handful of
+    /// sites however many islands the rectangle holds (#47: a pattern far
+    /// finer than the grid). Exact: the rectangle is split into `m_x x m_y`
+    /// whole supercells (their islands' area in closed form), the `m_x`
+    /// whole supercells' widths of the strip above them and the `m_y`
+    /// heights of the column beside them (each a copy of one window at most
+    /// a supercell wide and high, [`Sites::area_direct`]), and the corner.
+    /// A rectangle that spans no whole supercell either way is summed site
+    /// by site as it is ([`Sites::area_direct`], the same bits as before
+    /// #47).
+    fn area_in(&self, rect: &Rect) -> f64 {
+        let (px, py, sites) = supercell(self.lattice, self.pitch);
+        let mx = ((rect.x1 - rect.x0) / px).floor();
+        let my = ((rect.y1 - rect.y0) / py).floor();
+        let window = |x0, x1, y0, y1| self.area_direct(&Rect { x0, x1, y0, y1 });
+        if mx < 1.0 && my < 1.0 {
+            return self.area_direct(rect);
+        }
+        // The ends of the whole supercells (never past the rectangle's edge).
+        let xm = (rect.x0 + mx * px).min(rect.x1);
+        let ym = (rect.y0 + my * py).min(rect.y1);
+        let mut area = mx * my * sites * island_area(self.island);
+        if mx >= 1.0 {
+            area += mx * window(rect.x0, rect.x0 + px, ym, rect.y1);
+        }
+        if my >= 1.0 {
+            area += my * window(xm, rect.x1, rect.y0, rect.y0 + py);
+        }
+        area + window(xm, rect.x1, ym, rect.y1)
+    }
+
+    /// Area of the islands inside `rect`: every site whose island can
+    /// reach the rectangle, summed (islands never overlap,
+    /// [`Surface::validate`]).
+    fn area_direct(&self, rect: &Rect) -> f64 {
+        let Sites {
             island,
             lattice,
             pitch,
             offset,
             reach,
-            &Rect { x0, x1, y0, y1 },
-        )
-    };
-    if mx < 1.0 && my < 1.0 {
-        return area_in(rect.x0, rect.x1, rect.y0, rect.y1);
+        } = *self;
+        let (x0, x1) = (rect.x0 - reach - offset[0], rect.x1 + reach - offset[0]);
+        let (y0, y1) = (rect.y0 - reach - offset[1], rect.y1 + reach - offset[1]);
+        let (row, shear) = match lattice {
+            LatticeKind::Square => (pitch, 0.0),
+            LatticeKind::Hexagonal => (pitch * 3f64.sqrt() / 2.0, 0.5 * pitch),
+        };
+        let mut area = 0.0;
+        for j in (y0 / row).ceil() as i64..=(y1 / row).floor() as i64 {
+            let cy = j as f64 * row;
+            let start = shear * j as f64;
+            for i in ((x0 - start) / pitch).ceil() as i64..=((x1 - start) / pitch).floor() as i64 {
+                let cx = start + i as f64 * pitch;
+                let (sx, sy) = (offset[0] + cx, offset[1] + cy);
+                area += match island {
+                    Island::Circle { diameter } => disc_in_rect(sx, sy, 0.5 * diameter, rect),
+                    Island::Square { side } => rect_in_rect(&Rect::square(sx, sy, side), rect),
+                };
+            }
+        }
+        area
     }
-    // The ends of the whole supercells (never past the rectangle's edge).
-    let xm = (rect.x0 + mx * px).min(rect.x1);
-    let ym = (rect.y0 + my * py).min(rect.y1);
-    let mut area = mx * my * sites * island_area(island);
-    if mx >= 1.0 {
-        area += mx * area_in(rect.x0, rect.x0 + px, ym, rect.y1);
-    }
-    if my >= 1.0 {
-        area += my * area_in(xm, rect.x1, rect.y0, rect.y0 + py);
-    }
-    area + area_in(xm, rect.x1, ym, rect.y1)
 }
 
 /// Parallel ridges: the unit normal across them, the offset of one ridge's
@@ -763,39 +802,6 @@ impl Ridges {
             })
             .sum()
     }
-}
-
-/// Area of the islands of a lattice inside `rect`: every site whose island
-/// (circumradius `reach`) can reach the rectangle, summed (islands never
-/// overlap, [`Surface::validate`]).
-fn lattice_area_in(
-    island: Island,
-    lattice: LatticeKind,
-    pitch: f64,
-    offset: [f64; 2],
-    reach: f64,
-    rect: &Rect,
-) -> f64 {
-    let (x0, x1) = (rect.x0 - reach - offset[0], rect.x1 + reach - offset[0]);
-    let (y0, y1) = (rect.y0 - reach - offset[1], rect.y1 + reach - offset[1]);
-    let (row, shear) = match lattice {
-        LatticeKind::Square => (pitch, 0.0),
-        LatticeKind::Hexagonal => (pitch * 3f64.sqrt() / 2.0, 0.5 * pitch),
-    };
-    let mut area = 0.0;
-    for j in (y0 / row).ceil() as i64..=(y1 / row).floor() as i64 {
-        let cy = j as f64 * row;
-        let start = shear * j as f64;
-        for i in ((x0 - start) / pitch).ceil() as i64..=((x1 - start) / pitch).floor() as i64 {
-            let cx = start + i as f64 * pitch;
-            let (sx, sy) = (offset[0] + cx, offset[1] + cy);
-            area += match island {
-                Island::Circle { diameter } => disc_in_rect(sx, sy, 0.5 * diameter, rect),
-                Island::Square { side } => rect_in_rect(&Rect::square(sx, sy, side), rect),
-            };
-        }
-    }
-    area
 }
 
 #[cfg(test)]
@@ -1051,16 +1057,16 @@ mod tests {
                             side: size * std::f64::consts::FRAC_1_SQRT_2,
                         }
                     };
-                    let reach = island_reach(island);
                     let offset = [(rng.next() - 0.5) * pitch, (rng.next() - 0.5) * pitch];
+                    let sites = Sites::new(island, lattice, pitch, offset);
                     // 1 to 20 periods one way, 0 to 20 the other.
                     let mut span = [(1.0 + 20.0 * rng.next()).min(20.0), 20.0 * rng.next()];
                     if rng.next() < 0.5 {
                         span.swap(0, 1);
                     }
                     let rect = rng.rect(span[0] * px, span[1] * py, (px, py));
-                    let tiled = lattice_area_tiled(island, lattice, pitch, offset, reach, &rect);
-                    let direct = lattice_area_in(island, lattice, pitch, offset, reach, &rect);
+                    let tiled = sites.area_in(&rect);
+                    let direct = sites.area_direct(&rect);
                     worst = worst.max((tiled - direct).abs() / rect.area());
                     cells += 1;
                 }
@@ -1148,10 +1154,7 @@ mod tests {
                     lattice,
                     offset,
                     ..
-                } => {
-                    let reach = island_reach(*island);
-                    lattice_area_tiled(*island, *lattice, pitch, *offset, reach, &domain)
-                }
+                } => Sites::new(*island, *lattice, pitch, *offset).area_in(&domain),
                 Surface::Stripes {
                     width,
                     angle_deg,
