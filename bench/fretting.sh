@@ -9,6 +9,7 @@
 #
 # Usage: bench/fretting.sh [SIZES]   (default "256:1 512:0.5", points:spacing_um)
 #        MPCONTACT_EXE=/path/to/mpcontact bench/fretting.sh [SIZES]
+#        METHOD=active-set bench/fretting.sh [SIZES]   (solver.tangential_method; default cg)
 #        THREADS=1 bench/fretting.sh [SIZES]   (solve's --threads; default all cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,7 +20,7 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for s in $sizes; do
   n=${s%%:*}; h=${s##*:}
   for coupling in true false; do
-    set_args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling ${THREADS:+--threads $THREADS})
+    set_args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling ${THREADS:+--threads $THREADS} ${METHOD:+--set solver.tangential_method=\"$METHOD\"})
     $exe solve configs/paper-1a-fe.toml "${set_args[@]}" --out "$tmp/m" > /dev/null
     $exe solve configs/fretting-fe.toml "${set_args[@]}" --set history.fretting.cycles=1 --out "$tmp/f" > /dev/null
     ms=$(field "$tmp/m/case.json" seconds); mi=$(field "$tmp/m/case.json" tangential_iterations)

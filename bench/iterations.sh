@@ -9,6 +9,7 @@
 # bit on any), so THREADS only sets the time. Prints a markdown table.
 #
 # Usage: bench/iterations.sh [SIZES]   (default "512:0.5 1024:0.25 2048:0.125")
+#        METHOD=active-set (solver.tangential_method; default cg)
 #        STEPS=5 THREADS=2 MPCONTACT_EXE=/path/to/mpcontact bench/iterations.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +21,7 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for s in $sizes; do
   n=${s%%:*}; h=${s##*:}
   for coupling in true false; do
-    args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling ${THREADS:+--threads $THREADS})
+    args=(--set grid.points=$n --set grid.spacing_um=$h --set solver.coupling=$coupling ${THREADS:+--threads $THREADS} ${METHOD:+--set solver.tangential_method=\"$METHOD\"})
     $exe solve configs/paper-1a-fe.toml "${args[@]}" --out "$tmp/m" > /dev/null
     $exe solve configs/paper-1a-fe.toml "${args[@]}" --set 'history.tangential_ratios=[0.0, 0.6]' \
       --set history.steps_per_segment=$steps --out "$tmp/h" > /dev/null

@@ -295,6 +295,7 @@ fn slip(n: usize, args: &Args, threads: &Threads, coupling: bool) {
             max_iterations: 20_000,
             start: TangentialStart::Proportional,
             precondition: false,
+            method: Default::default(),
         };
         let in_situ = in_situ_ratio(|| {
             res.solve_tangential(&prob).expect("tangential solve");

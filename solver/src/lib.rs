@@ -108,7 +108,9 @@ pub use model::radii::{
     Radii, APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
-pub use model::spec::{CaseSpec, Load, LoadHistory, Numerics, MAX_GRID_POINTS, MAX_HISTORY_STEPS};
+pub use model::spec::{
+    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, MAX_GRID_POINTS, MAX_HISTORY_STEPS,
+};
 pub use model::surface::{
     Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER, RESOLVED_CELLS_PER_PITCH,
 };

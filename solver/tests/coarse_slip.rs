@@ -51,6 +51,7 @@ fn problem(p: &[f64]) -> TangentialProblem<'_> {
         max_iterations: 5000,
         start: TangentialStart::Proportional,
         precondition: false,
+        method: Default::default(),
     }
 }
 

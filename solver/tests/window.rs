@@ -155,6 +155,7 @@ fn windowed_and_whole_grid_tangential_solves_agree_for_a_111_crystal() {
         max_iterations: 20_000,
         start: TangentialStart::Proportional,
         precondition: false,
+        method: Default::default(),
     };
     let whole = solve_tangential_on_grid(&mut op, &prob).unwrap();
     let mut windows = WindowCache::default();

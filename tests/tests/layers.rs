@@ -42,6 +42,7 @@ fn solver() -> Layers {
             ("solve", "fista"),
             ("solve", "coarse_slip"),
             ("solve", "window"),
+            ("solve", "active_set"),
             ("solve", "tangential"),
             ("solve", "tangential_displacement"),
             ("solve", "resident"),

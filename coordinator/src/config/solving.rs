@@ -32,6 +32,10 @@ pub struct SolverCfg {
     /// or `"hull"` (the paper's, pinned by the configs that reproduce it).
     #[serde(default = "default_radii")]
     pub radii: solver::Radii,
+    /// The tangential solve's iteration: `"cg"` (the default) or
+    /// `"active-set"` (issue #48).
+    #[serde(default = "default_method")]
+    pub tangential_method: solver::TangentialMethod,
 }
 
 fn yes() -> bool {
@@ -56,6 +60,9 @@ fn default_citer() -> usize {
 fn default_radii() -> solver::Radii {
     Numerics::default().radii
 }
+fn default_method() -> solver::TangentialMethod {
+    Numerics::default().tangential_method
+}
 
 impl Default for SolverCfg {
     fn default() -> Self {
@@ -67,6 +74,7 @@ impl Default for SolverCfg {
             coupling_tolerance: default_ctol(),
             max_coupling_iterations: default_citer(),
             radii: default_radii(),
+            tangential_method: default_method(),
         }
     }
 }
@@ -123,6 +131,7 @@ impl SolverCfg {
             coupling_tolerance: self.coupling_tolerance,
             max_coupling_iterations: self.max_coupling_iterations,
             radii: self.radii,
+            tangential_method: self.tangential_method,
         }
     }
 }

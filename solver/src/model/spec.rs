@@ -47,6 +47,25 @@ impl Load {
     }
 }
 
+/// The iteration of a tangential solve's first phase (both end, if they
+/// have not converged, in the same projected-gradient phase and are judged
+/// by the same KKT test).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum TangentialMethod {
+    /// The projected conjugate gradient over the stick cells' tractions
+    /// and the slip cells' rotation on their discs (Jacobi-preconditioned;
+    /// a load history's warm starts with the Fourier `|k|` multiplier on the
+    /// stick cells).
+    #[default]
+    #[serde(rename = "cg")]
+    ConjugateGradient,
+    /// The active-set iteration of `crate::solve::active_set`: inner PCG
+    /// on a frozen stick/slip split with the inverse of the compliance's
+    /// circulant embedding as preconditioner (issue #48).
+    #[serde(rename = "active-set")]
+    ActiveSet,
+}
+
 /// Tolerances and budgets of the solvers.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Numerics {
@@ -66,6 +85,9 @@ pub struct Numerics {
     /// solution.
     #[serde(default)]
     pub radii: Radii,
+    /// The tangential solve's iteration (`solver.tangential_method`).
+    #[serde(default)]
+    pub tangential_method: TangentialMethod,
 }
 
 impl Default for Numerics {
@@ -81,6 +103,7 @@ impl Default for Numerics {
             coupling_tolerance: 1e-7,
             max_coupling_iterations: 50,
             radii: Radii::default(),
+            tangential_method: Default::default(),
         }
     }
 }

@@ -173,6 +173,58 @@ fn mix(k: &[[Kr; 2]; 2], ns: usize, nd: usize, w0: &mut [Complex64], w1: &mut [C
     }
 }
 
+/// Smallest eigenvalue of the tangential symbol that
+/// [`Operator::tangential_inverse`] inverts as it is, relative to a cell's
+/// own compliance `K(0, 0)`; smaller ones are raised to it. The embedding's
+/// kernel is zero on the row and column `N` that separate positive from
+/// negative offsets, and its symbol is not positive definite: isotropic Fe
+/// at 256² and 512² (Table 1(a)'s grids) has smallest eigenvalue −0.008
+/// `K(0, 0)` and 170 / 341 frequencies below 0.25 `K(0, 0)` (Galerkin coarse
+/// levels, 0.19–0.37 and positive). Inverted as they are, those modes made
+/// the preconditioner useless: a five-increment history at 256² took 80
+/// tangential iterations per increment with a floor of 1e-3, 15–16 with
+/// 0.1, 0.25 or 0.4.
+pub const INVERSE_FLOOR: f64 = 0.25;
+
+/// The products of [`Operator::tangential_inverse`] over one column: `(w0,
+/// w1) ← (K̂ + σ I)⁻¹ (w0, w1)` with `K̂ = [[K_xx, K_xy], [conj K_xy,
+/// K_yy]]` per frequency, its eigenvalues raised to `floor` where below.
+fn mix_inverse(
+    k: &[[Kr; 2]; 2],
+    [shift, floor]: [f64; 2],
+    w0: &mut [Complex64],
+    w1: &mut [Complex64],
+) {
+    let (kxx, kxy, kyy) = (k[0][0], k[0][1], k[1][1]);
+    for (f, (x, y)) in w0.iter_mut().zip(w1.iter_mut()).enumerate() {
+        let a = kxx.at(f).re + shift;
+        let d = kyy.at(f).re + shift;
+        let b = kxy.at(f);
+        let b2 = b.norm_sqr();
+        // Both eigenvalues ≥ floor ⟺ a ≥ floor and (a − floor)(d − floor) ≥
+        // |b|²: the usual case, without a square root.
+        let (i00, i01, i11) = if a >= floor && (a - floor) * (d - floor) >= b2 {
+            let r = 1.0 / (a * d - b2);
+            (d * r, -b * r, a * r)
+        } else {
+            // (1/λ₁') P₁ + (1/λ₂') P₂ with P₁ = (K − λ₂)/(λ₁ − λ₂), P₂ = I − P₁.
+            let mean = 0.5 * (a + d);
+            let disc = (0.25 * (a - d) * (a - d) + b2).sqrt();
+            let (l1, l2) = (mean + disc, mean - disc);
+            let (r1, r2) = (1.0 / l1.max(floor), 1.0 / l2.max(floor));
+            if disc > 0.0 {
+                let c = (r1 - r2) / (l1 - l2);
+                (r2 + c * (a - l2), c * b, r2 + c * (d - l2))
+            } else {
+                (r1, Complex64::default(), r1)
+            }
+        };
+        let (u, v) = (*x, *y);
+        *x = u * i00 + v * i01;
+        *y = u * i01.conj() + v * i11;
+    }
+}
+
 /// `Σ_f conj(â, b̂) K̂ (â, b̂)ᵀ` over one column of the symmetric tangential
 /// block's spectra: `K_xx |â|² + K_yy |b̂|² + 2 Re(conj(â) K_xy b̂)`. Four
 /// partial sums, so the additions do not wait on each other.
@@ -741,7 +793,7 @@ impl Operator {
     /// passes over the work spectra.
     fn round(&mut self, src: &[(usize, &[f64])], dst: &mut [(usize, &mut [f64])], add: bool) {
         let threads = self.fft.threads().clone();
-        threads.install(|| self.round_stages(src, dst, add));
+        threads.install(|| self.round_stages(src, dst, add, None));
     }
 
     /// The stages of [`Operator::round`].
@@ -750,6 +802,7 @@ impl Operator {
         src: &[(usize, &[f64])],
         dst: &mut [(usize, &mut [f64])],
         add: bool,
+        inverse: Option<[f64; 2]>,
     ) {
         self.ensure_work();
         let [w0, w1] = &mut self.work;
@@ -778,7 +831,10 @@ impl Operator {
                 let kc = k.map(|row| row.map(|kr| kr.part(r.clone())));
                 {
                     let _span = crate::operators::fft2::timing::Span::product();
-                    mix(&kc, ns, nd, c0, c1);
+                    match inverse {
+                        None => mix(&kc, ns, nd, c0, c1),
+                        Some(shift) => mix_inverse(&kc, shift, c0, c1),
+                    }
                 }
                 cols.inverse(c0);
                 if nd > 1 {
@@ -790,7 +846,9 @@ impl Operator {
         for ((_, u), w) in dst.iter_mut().zip([w0, w1]) {
             self.fft.inverse_rows_cropped(w, u, add);
         }
-        self.add_cut(src, dst);
+        if inverse.is_none() {
+            self.add_cut(src, dst);
+        }
     }
 
     /// The elastic energy product `⟨t, K t⟩ = Σ_cells t · (K t)` of a shear
@@ -863,6 +921,35 @@ impl Operator {
         self.tangential_self
     }
 
+    /// `(ux, uy) = crop (K̂ + σ I)⁻¹ pad (qx, qy)`: the inverse of the
+    /// `2N`-circulant embedding of the tangential block, shifted by `σ`
+    /// (m/Pa) on its diagonal, applied to the zero-padded field and read
+    /// back on the grid (CONTACT's `fft_makePrec`; Zhao, Vollebregt &
+    /// Oosterlee 2015). The 2x2 Hermitian symbol is inverted per frequency
+    /// as the column pass reaches it (no stored spectra); eigenvalues below
+    /// [`INVERSE_FLOOR`] times a cell's own compliance are raised to it, so
+    /// that the result is symmetric positive definite whatever the
+    /// embedding's spectrum. The cut cells' extra compliance is not in it:
+    /// the caller scales around it ([`Operator::scale_cut`]). The
+    /// tangential solver's preconditioner.
+    pub fn tangential_inverse(
+        &mut self,
+        shift: f64,
+        (qx, qy): (&[f64], &[f64]),
+        (ux, uy): (&mut [f64], &mut [f64]),
+    ) {
+        let floor = INVERSE_FLOOR * self.tangential_self;
+        let threads = self.fft.threads().clone();
+        threads.install(|| {
+            self.round_stages(
+                &[(X, qx), (Y, qy)],
+                &mut [(X, ux), (Y, uy)],
+                false,
+                Some([shift, floor]),
+            )
+        });
+    }
+
     /// Normal displacement under pressure only: `uz = K_zz * p`.
     pub fn normal(&mut self, p: &[f64], uz: &mut [f64]) {
         self.apply(&[(Z, p)], &mut [(Z, uz)]);
@@ -923,6 +1010,79 @@ mod tests {
         assert!(k[X][X] != k[Y][Y]);
         let err = (op.tangential_self() - want).abs() / want;
         assert!(err < 1e-12, "{} vs {want}: {err:e}", op.tangential_self());
+    }
+
+    /// The inverse of the `2N`-circulant embedding, shifted, against a dense
+    /// inverse of that circulant built from the kernel tables (isotropic and
+    /// a (111) crystal, whose `K_xy` spectrum is complex), on both FFT paths.
+    #[test]
+    fn tangential_inverse_equals_the_dense_circulant_inverse() {
+        let grid = grid(6, 1.0e-6, 1.0e-6);
+        let iso = |x: f64, y: f64| isotropic_cell(80.0e9, 0.27, x, y, grid.dx, grid.dy);
+        let ops = [
+            Operator::build(grid, iso),
+            Operator::build(grid, cu111_cell(grid)),
+        ];
+        for mut op in ops {
+            for split in [false, true] {
+                op = op.with_split_columns(split);
+                let n = grid.n;
+                let m = 2 * n;
+                let tab = [
+                    [op.table(X, X), op.table(X, Y)],
+                    [op.table(Y, X), op.table(Y, Y)],
+                ];
+                let shift = 2.0 * op.tangential_self();
+                // A[(a, p), (b, p')] = K_ab(p − p') on the wrap-around grid.
+                let dim = 2 * m * m;
+                let mut a = nalgebra::DMatrix::<f64>::zeros(dim, dim);
+                for (ia, ta) in tab.iter().enumerate() {
+                    for (ib, t) in ta.iter().enumerate() {
+                        for py in 0..m {
+                            for px in 0..m {
+                                for qy in 0..m {
+                                    for qx in 0..m {
+                                        let (dy, dx) = ((py + m - qy) % m, (px + m - qx) % m);
+                                        a[(ia * m * m + py * m + px, ib * m * m + qy * m + qx)] =
+                                            t[dy * m + dx];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                for k in 0..dim {
+                    a[(k, k)] += shift;
+                }
+                let inv = a
+                    .try_inverse()
+                    .expect("the shifted circulant is invertible");
+                let tx = pseudo_random(n * n, 3);
+                let ty = pseudo_random(n * n, 4);
+                let mut rhs = nalgebra::DVector::<f64>::zeros(dim);
+                for iy in 0..n {
+                    for ix in 0..n {
+                        rhs[iy * m + ix] = tx[iy * n + ix];
+                        rhs[m * m + iy * m + ix] = ty[iy * n + ix];
+                    }
+                }
+                let want = inv * rhs;
+                let (mut ux, mut uy) = (vec![0.0; n * n], vec![0.0; n * n]);
+                op.tangential_inverse(shift, (&tx, &ty), (&mut ux, &mut uy));
+                let mut err = 0.0_f64;
+                let mut top = 0.0_f64;
+                for iy in 0..n {
+                    for ix in 0..n {
+                        let (wx, wy) = (want[iy * m + ix], want[m * m + iy * m + ix]);
+                        err = err
+                            .max((wx - ux[iy * n + ix]).abs())
+                            .max((wy - uy[iy * n + ix]).abs());
+                        top = top.max(wx.abs()).max(wy.abs());
+                    }
+                }
+                assert!(err < 1e-10 * top, "split {split}: {err:e} of {top:e}");
+            }
+        }
     }
 
     #[test]

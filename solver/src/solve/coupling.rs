@@ -311,6 +311,7 @@ pub(crate) fn solve_step(
                 // each iteration: 29.6 / 32.9 s → 34.4 / 38.3 s, so coupled
                 // passes keep the Jacobi preconditioner.
                 precondition: previous.is_some() && !num.coupling,
+                method: num.tangential_method,
             };
             // From the second pass on, the last pass's tractions start the
             // solve, which takes them over (they are replaced by its own).

@@ -22,19 +22,13 @@ use crate::base::parallel::{Chunks, Threads};
 use crate::error::SolverError;
 use crate::operators::multilevel::FourierPrecond;
 use crate::operators::operator::Operator;
+use crate::solve::active_set::{active_set, norm, solve2, Controls, Feasible};
 use crate::solve::coarse_slip::{coarse_start, TangentialLevels};
 use crate::solve::fista::{self, Momentum};
 pub use crate::solve::tangential_problem::{
-    TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
+    TangentialMethod, TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
 };
 use crate::solve::window::{contact_window, WindowCache};
-
-/// `|(x, y)|` without `hypot`'s overflow guard (tractions and slips are far
-/// from the f64 range; `hypot` cost a twentieth of a tangential solve).
-#[inline(always)]
-fn norm(x: f64, y: f64) -> f64 {
-    (x * x + y * y).sqrt()
-}
 
 /// The slip field `s = C q + e` of tractions `q` (`e`: the coupling term, if any).
 fn slip_field(
@@ -49,63 +43,6 @@ fn slip_field(
             sx[i] += ex[i];
             sy[i] += ey[i];
         }
-    }
-}
-
-/// The feasible set of a solve, { |q_i| ≤ b_i on `cells`, Σ q_i = target }.
-#[derive(Clone, Copy)]
-struct Feasible<'a> {
-    /// The contact cells.
-    cells: &'a [usize],
-    /// Their fixed pieces, on which every pass over them runs, and the
-    /// threads those passes may use (see [`crate::base::parallel`]).
-    chunks: &'a Chunks<'a>,
-    threads: &'a Threads,
-    /// Pressure per cell, Pa: the friction bound is [`Feasible::bound`].
-    p: &'a [f64],
-    /// Friction coefficient.
-    mu: f64,
-    /// Σ b_i over `cells` (fixed for a solve, so it is summed once).
-    cap: f64,
-    /// Σ q_i required: the force over the cell area, Pa.
-    target: [f64; 2],
-}
-
-impl<'a> Feasible<'a> {
-    /// The set of the contact cells of `chunks` of the pressure `p`.
-    fn new(
-        (chunks, threads): (&'a Chunks<'a>, &'a Threads),
-        cells: &'a [usize],
-        p: &'a [f64],
-        mu: f64,
-        target: [f64; 2],
-    ) -> Self {
-        let mut set = Feasible {
-            cells,
-            chunks,
-            threads,
-            p,
-            mu,
-            cap: 0.0,
-            target,
-        };
-        // Σ b_i over the contact cells: the largest force the discs can carry.
-        let parts = threads.chunked(chunks, chunks.items(), |part| {
-            let mut s = 0.0;
-            for &i in part.list() {
-                s += set.bound(i);
-            }
-            s
-        });
-        set.cap = parts.into_iter().fold(0.0, |a, b| a + b);
-        set
-    }
-
-    /// Friction bound b_i = μ p_i of cell `i`, Pa (computed where it is
-    /// used: a stored field of them was 34 MB of a 2048² solve's peak).
-    #[inline]
-    fn bound(&self, i: usize) -> f64 {
-        self.mu * self.p[i].max(0.0)
     }
 }
 
@@ -450,21 +387,50 @@ fn on_grid_taking(
 
     // Phase 1: projected conjugate gradient (below). Phase 2, only if phase 1
     // did not converge: FISTA from where it stopped.
-    let mut own = None;
-    let fourier = match fourier {
-        Some(f) => Some(f),
-        None if fourier_pays(prob, grid) => Some(own.insert(FourierPrecond::new(grid))),
-        None => None,
+    let cg = match prob.method {
+        TangentialMethod::ConjugateGradient => {
+            let mut own = None;
+            let fourier = match fourier {
+                Some(f) => Some(f),
+                None if fourier_pays(prob, grid) => Some(own.insert(FourierPrecond::new(grid))),
+                None => None,
+            };
+            cg_disc(
+                (op, fourier),
+                prob,
+                &set,
+                (&mut qx, &mut qy),
+                (&mut sx, &mut sy),
+                (&mut zx, &mut zy),
+                &mut lambda,
+            )?
+        }
+        TangentialMethod::ActiveSet => {
+            let ctl = Controls {
+                tolerance: prob.tolerance,
+                floor: prob.slip_floor,
+                budget: prob.max_iterations,
+            };
+            let out = active_set(
+                op,
+                prob.extra,
+                &set,
+                ctl,
+                (&mut qx, &mut qy),
+                (&mut sx, &mut sy),
+            )?;
+            report.preconditioner_applications = out.inverses;
+            report.split_updates = out.split_updates;
+            CgOutcome {
+                iterations: out.iterations,
+                applications: out.applications,
+                energy_products: 0,
+                kkt: out.kkt,
+                shift: out.shift,
+                converged: out.converged,
+            }
+        }
     };
-    let cg = cg_disc(
-        (op, fourier),
-        prob,
-        &set,
-        (&mut qx, &mut qy),
-        (&mut sx, &mut sy),
-        (&mut zx, &mut zy),
-        &mut lambda,
-    )?;
     report.cg_iterations = cg.iterations;
     report.applications = cg.applications;
     report.energy_products = cg.energy_products;
@@ -1063,7 +1029,9 @@ pub const FOURIER_STICK_MAX_SIDE: usize = 1024;
 
 /// Whether `prob`'s solve on `grid` uses the Fourier stick preconditioner.
 fn fourier_pays(prob: &TangentialProblem, grid: crate::base::grid::Grid) -> bool {
-    prob.precondition && grid.n <= FOURIER_STICK_MAX_SIDE
+    prob.method == TangentialMethod::ConjugateGradient
+        && prob.precondition
+        && grid.n <= FOURIER_STICK_MAX_SIDE
 }
 
 /// Diagonal of the stick cells' Fourier preconditioner relative to the
@@ -1174,17 +1142,4 @@ impl SlipCell {
 #[inline]
 fn on_rim(qx: f64, qy: f64, b: f64) -> bool {
     norm(qx, qy) >= (1.0 - 1e-12) * b
-}
-
-/// The solution of the 2x2 system `a x = b` by Cramer's rule, or `None`
-/// when `a` is singular to working precision (|det| ≤ 1e-300): the Newton
-/// step of [`project`] and the force-constraint multipliers of [`cg_disc`].
-fn solve2(a: [[f64; 2]; 2], b: [f64; 2]) -> Option<[f64; 2]> {
-    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-    (det.abs() > 1e-300).then(|| {
-        [
-            (a[1][1] * b[0] - a[0][1] * b[1]) / det,
-            (a[0][0] * b[1] - a[1][0] * b[0]) / det,
-        ]
-    })
 }

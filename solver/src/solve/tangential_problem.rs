@@ -4,6 +4,8 @@
 //! the tangential solver and its coarse-to-fine start (`coarse_slip`), which
 //! speak these types; `tangential` re-exports them. Solves nothing.
 
+pub use crate::model::spec::TangentialMethod;
+
 /// Convergence report of one tangential solve.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TangentialReport {
@@ -31,6 +33,15 @@ pub struct TangentialReport {
     /// conjugate-gradient step lengths.
     #[serde(default)]
     pub energy_products: usize,
+    /// Preconditioner applications of the active-set iteration (inverse
+    /// circulants of the tangential block, each an operator application's
+    /// transforms).
+    #[serde(default)]
+    pub preconditioner_applications: usize,
+    /// Outer updates of the active-set iteration that changed the stick/slip
+    /// split.
+    #[serde(default)]
+    pub split_updates: usize,
     /// Iterations on the coarse levels of a coarse-to-fine start (each costs
     /// a quarter, a sixteenth, … of a fine one); not part of `iterations`.
     #[serde(default)]
@@ -104,4 +115,6 @@ pub struct TangentialProblem<'a> {
     /// [`crate::solve::tangential::FOURIER_STICK_MAX_SIDE`]; false (or a larger
     /// side): the diagonal (Jacobi) preconditioner.
     pub precondition: bool,
+    /// The first phase's iteration.
+    pub method: TangentialMethod,
 }
