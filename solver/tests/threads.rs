@@ -121,3 +121,25 @@ fn uncoupled_and_coupled_load_histories_are_bit_identical_on_1_2_and_3_threads()
         assert!(!one.turning.is_empty(), "coupling {coupling}");
     }
 }
+
+/// The active-set iteration (`solver.tangential_method = "active-set"`): a
+/// coupled monotonic case and an uncoupled history, the same bits on 1, 2
+/// and 3 threads at every size (its passes over the cells run in order; its
+/// transforms are the operator's).
+#[test]
+fn the_active_set_iteration_is_bit_identical_on_1_2_and_3_threads() {
+    for (coupling, history) in [(true, false), (false, true)] {
+        let mut spec = table_1a_fe(128, 2.0, coupling, 0.6);
+        spec.numerics.tangential_method = solver::TangentialMethod::ActiveSet;
+        if history {
+            spec.history = Some(LoadHistory {
+                tangential_ratios: vec![0.0, 0.6, -0.6],
+                normal_forces_n: None,
+                steps_per_segment: 4,
+                shifts_m: None,
+            });
+        }
+        let one = same_on_1_2_and_3_threads(&spec, true);
+        assert!(one.scalars.converged, "coupling {coupling}");
+    }
+}
