@@ -8,10 +8,10 @@
 
 mod common;
 
-use common::table_1a_fe;
-use solver::influence::isotropic_cell;
-use solver::normal::{solve_normal, NormalCache, NormalProblem};
-use solver::operator::{Grid, Operator};
+use common::{
+    hertz_fe as hertz, quick_1c, table_1a_fe, tangential_difference as compare, LOAD_1A, MU_1A,
+};
+use solver::operator::Operator;
 use solver::tangential::{
     solve_tangential, solve_tangential_on_grid, TangentialMethod, TangentialProblem,
     TangentialSolution, TangentialStart,
@@ -19,58 +19,11 @@ use solver::tangential::{
 use solver::window::WindowCache;
 use solver::{solve_case, CaseSpec, KernelCache, LoadHistory};
 
-const MU: f64 = 0.28571;
-const LOAD: f64 = 20.0;
+const MU: f64 = MU_1A;
+const LOAD: f64 = LOAD_1A;
 const TOL: f64 = 1e-6;
 
-/// Fe under a sphere of 18 mm: the Hertz pressure on an `n x n` grid of
-/// cell `d`, and the operator.
-fn hertz(n: usize, d: f64) -> (Operator, Vec<f64>) {
-    let grid = Grid { n, dx: d, dy: d };
-    let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
-    let g = e / (2.0 * (1.0 + nu));
-    let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
-    let h: Vec<f64> = (0..grid.len())
-        .map(|i| {
-            let (x, y) = (grid.x(i % n), grid.y(i / n));
-            (x * x + y * y) / (2.0 * r)
-        })
-        .collect();
-    let mut cache = NormalCache::new(&mut op);
-    let p = solve_normal(&mut op, &mut cache, &NormalProblem::new(&h, LOAD))
-        .unwrap()
-        .p;
-    (op, p)
-}
-
-fn problem(p: &[f64], method: TangentialMethod) -> TangentialProblem<'_> {
-    TangentialProblem {
-        p,
-        friction: MU,
-        force: [0.6 * MU * LOAD, 0.0],
-        extra: None,
-        tolerance: TOL,
-        slip_floor: 0.0,
-        max_iterations: 5000,
-        start: TangentialStart::Proportional,
-        precondition: false,
-        method,
-    }
-}
-
-/// max |Δq| / (μ p_max), |Δδt| / |δt| and the number of cells whose stick
-/// state differs.
-fn compare(a: &TangentialSolution, b: &TangentialSolution, p: &[f64]) -> (f64, f64, usize) {
-    let pmax = p.iter().cloned().fold(0.0, f64::max);
-    let dq = (0..p.len())
-        .map(|i| (a.qx[i] - b.qx[i]).hypot(a.qy[i] - b.qy[i]))
-        .fold(0.0, f64::max)
-        / (MU * pmax);
-    let dt =
-        (a.shift[0] - b.shift[0]).hypot(a.shift[1] - b.shift[1]) / a.shift[0].hypot(a.shift[1]);
-    let stick = (0..p.len()).filter(|&i| a.stick[i] != b.stick[i]).count();
-    (dq, dt, stick)
-}
+use common::cattaneo_problem as problem;
 
 /// Two solutions whose KKT residuals are below 1e-6 |δt| differ in traction
 /// by about the residual times the inverse compliance (1e-5 μ p_max here,
@@ -151,21 +104,7 @@ fn with_method(mut spec: CaseSpec, method: TangentialMethod) -> CaseSpec {
 /// tolerances, which both meet differently).
 #[test]
 fn coupled_crystal_and_patterned_cases_agree_with_the_conjugate_gradient() {
-    let quick = |material: &str, surface: &str, angle_deg: f64| CaseSpec {
-        material: solver::presets::material(material).unwrap(),
-        surface: solver::presets::surface(surface).unwrap(),
-        grid: solver::Grid::square(128, 60e-6),
-        load: solver::Load {
-            indenter_radius_m: 0.2,
-            normal_force_n: 6000.0,
-            friction: 0.3,
-            tangential_ratio: 0.6,
-            angle_deg,
-        },
-        numerics: solver::Numerics::default(),
-        history: None,
-        indenter: None,
-    };
+    let quick = quick_1c;
     let cases = [
         ("Fe, Table 1(a)", table_1a_fe(128, 2.0, true, 0.6)),
         ("Cu(111) at 30°", quick("Cu(111)", "flat", 30.0)),

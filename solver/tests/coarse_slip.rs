@@ -6,68 +6,26 @@
 //! two solutions whose slip residuals are below 1e-6 |δt| differ in traction
 //! by the residual times the inverse compliance, about 10x here).
 
+mod common;
+
+use common::{hertz_fe as hertz, LOAD_1A, MU_1A};
 use solver::coarse_slip::TangentialLevels;
-use solver::influence::isotropic_cell;
-use solver::normal::{solve_normal, NormalCache, NormalProblem};
-use solver::operator::{Grid, Operator};
+use solver::operator::Operator;
 use solver::tangential::{
     solve_nested, solve_tangential, solve_tangential_on_grid, TangentialProblem,
     TangentialSolution, TangentialStart,
 };
 use solver::window::WindowCache;
 
-const MU: f64 = 0.28571;
-const LOAD: f64 = 20.0;
+const MU: f64 = MU_1A;
+const LOAD: f64 = LOAD_1A;
 const TOL: f64 = 1e-6;
 
-/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm: the Hertz pressure on
-/// an `n x n` grid of cell `d`, and the operator.
-fn hertz(n: usize, d: f64) -> (Operator, Vec<f64>) {
-    let grid = Grid { n, dx: d, dy: d };
-    let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
-    let g = e / (2.0 * (1.0 + nu));
-    let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
-    let h: Vec<f64> = (0..grid.len())
-        .map(|i| {
-            let (x, y) = (grid.x(i % n), grid.y(i / n));
-            (x * x + y * y) / (2.0 * r)
-        })
-        .collect();
-    let mut cache = NormalCache::new(&mut op);
-    let p = solve_normal(&mut op, &mut cache, &NormalProblem::new(&h, LOAD))
-        .unwrap()
-        .p;
-    (op, p)
-}
-
 fn problem(p: &[f64]) -> TangentialProblem<'_> {
-    TangentialProblem {
-        p,
-        friction: MU,
-        force: [0.6 * MU * LOAD, 0.0],
-        extra: None,
-        tolerance: TOL,
-        slip_floor: 0.0,
-        max_iterations: 5000,
-        start: TangentialStart::Proportional,
-        precondition: false,
-        method: Default::default(),
-    }
+    common::cattaneo_problem(p, Default::default())
 }
 
-/// max |Δq| / (μ p_max), |Δδt| / |δt| and the number of cells whose stick
-/// state differs.
-fn compare(a: &TangentialSolution, b: &TangentialSolution, p: &[f64]) -> (f64, f64, usize) {
-    let pmax = p.iter().cloned().fold(0.0, f64::max);
-    let dq = (0..p.len())
-        .map(|i| (a.qx[i] - b.qx[i]).hypot(a.qy[i] - b.qy[i]))
-        .fold(0.0, f64::max)
-        / (MU * pmax);
-    let dt =
-        (a.shift[0] - b.shift[0]).hypot(a.shift[1] - b.shift[1]) / a.shift[0].hypot(a.shift[1]);
-    let stick = (0..p.len()).filter(|&i| a.stick[i] != b.stick[i]).count();
-    (dq, dt, stick)
-}
+use common::tangential_difference as compare;
 
 #[test]
 fn nested_start_reaches_the_plain_fine_solution_on_the_whole_grid() {

@@ -264,24 +264,13 @@ fn proportional_loading_below_mu_leaves_no_slip() {
 /// 128² of 60 µm), one fretting cycle of amplitude 0.6 μP, coupled.
 fn quick_fretting(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
     CaseSpec {
-        material: solver::presets::material(material).unwrap(),
-        surface: solver::presets::surface(surface).unwrap(),
-        grid: solver::Grid::square(128, 60e-6),
-        load: solver::Load {
-            indenter_radius_m: 0.2,
-            normal_force_n: 6000.0,
-            friction: 0.3,
-            tangential_ratio: 0.6,
-            angle_deg,
-        },
-        numerics: solver::Numerics::default(),
         history: Some(LoadHistory {
             tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
             normal_forces_n: None,
             steps_per_segment: 10,
             shifts_m: None,
         }),
-        indenter: None,
+        ..common::quick_1c(material, surface, angle_deg)
     }
 }
 

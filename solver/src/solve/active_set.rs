@@ -427,15 +427,41 @@ impl<'a> Work<'a> {
         }
     }
 
-    /// The linearised KKT measure of the frozen split (max over stick cells
-    /// of `|s − δ|`, over slip cells of `|t·(s − δ) + κ τ|`, `τ = t·x`),
-    /// relative to `max(|δ|, floor)`; `None` without stick cells.
+    /// The KKT measure of the frozen split, relative to `max(|δ|, floor)`,
+    /// with `δ` and that scale (`None` without stick cells): max over stick
+    /// cells of `|s − δ|`, over slip cells of the linearised `|t·(s − δ) +
+    /// κ τ|` (`τ = t·x`), or (`exact`, on a state with every slip cell on
+    /// its rim) the product's `|w + |w| n|` (`w = s − δ`, `n` the traction's
+    /// direction: zero when the traction opposes the slip).
     fn kkt(
         &self,
         sp: &Split,
         floor: f64,
         (xx, xy): (&[f64], &[f64]),
+        s: (&[f64], &[f64]),
+        exact: bool,
+    ) -> Option<(f64, [f64; 2], f64)> {
+        self.measure(sp, floor, s, |i, w| {
+            if exact {
+                let r = norm(w[0], w[1]) / norm(xx[i], xy[i]);
+                norm(w[0] + r * xx[i], w[1] + r * xy[i])
+            } else {
+                let t = sp.t(i);
+                let tau = t[0] * xx[i] + t[1] * xy[i];
+                (t[0] * w[0] + t[1] * w[1] + sp.kap[i] * tau).abs()
+            }
+        })
+    }
+
+    /// The KKT measure with slip cells' term `slip(i, s_i − δ)`: `δ` the
+    /// stick cells' mean slip, the max over stick cells of `|s − δ|` and
+    /// over slip cells of their term, relative to `max(|δ|, floor)`.
+    fn measure(
+        &self,
+        sp: &Split,
+        floor: f64,
         (sx, sy): (&[f64], &[f64]),
+        slip: impl Fn(usize, [f64; 2]) -> f64,
     ) -> Option<(f64, [f64; 2], f64)> {
         let cells = self.set.cells;
         let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
@@ -453,14 +479,12 @@ impl<'a> Work<'a> {
         let scale = norm(d[0], d[1]).max(floor).max(f64::MIN_POSITIVE);
         let mut e = 0.0_f64;
         for &i in cells {
-            let (wx, wy) = (sx[i] - d[0], sy[i] - d[1]);
-            if sp.stick[i] {
-                e = e.max(norm(wx, wy));
+            let w = [sx[i] - d[0], sy[i] - d[1]];
+            e = e.max(if sp.stick[i] {
+                norm(w[0], w[1])
             } else {
-                let t = sp.t(i);
-                let tau = t[0] * xx[i] + t[1] * xy[i];
-                e = e.max((t[0] * wx + t[1] * wy + sp.kap[i] * tau).abs());
-            }
+                slip(i, w)
+            });
         }
         Some((e / scale, d, scale))
     }
@@ -540,44 +564,6 @@ impl<'a> Work<'a> {
         }
         changed
     }
-
-    /// The product's KKT measure of a state with every slip cell on its
-    /// rim: max over stick cells of `|s − δ|`, over slip cells of `|w +
-    /// |w| n|` (`w = s − δ`: zero when the traction opposes the slip),
-    /// relative to `max(|δ|, floor)`.
-    fn kkt_exact(
-        &self,
-        sp: &Split,
-        floor: f64,
-        (xx, xy): (&[f64], &[f64]),
-        (sx, sy): (&[f64], &[f64]),
-    ) -> Option<(f64, [f64; 2], f64)> {
-        let cells = self.set.cells;
-        let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
-        for &i in cells {
-            if sp.stick[i] {
-                mx += sx[i];
-                my += sy[i];
-                ns += 1;
-            }
-        }
-        if ns == 0 {
-            return None;
-        }
-        let d = [mx / ns as f64, my / ns as f64];
-        let scale = norm(d[0], d[1]).max(floor).max(f64::MIN_POSITIVE);
-        let mut e = 0.0_f64;
-        for &i in cells {
-            let (wx, wy) = (sx[i] - d[0], sy[i] - d[1]);
-            if sp.stick[i] {
-                e = e.max(norm(wx, wy));
-            } else {
-                let w = norm(wx, wy) / norm(xx[i], xy[i]);
-                e = e.max(norm(wx + w * xx[i], wy + w * xy[i]));
-            }
-        }
-        Some((e / scale, d, scale))
-    }
 }
 
 /// Whether slip cell `i` with slip `w` (relative to the shift) and traction
@@ -616,8 +602,9 @@ fn mul2(a: [[f64; 2]; 2], v: [f64; 2]) -> [f64; 2] {
     ]
 }
 
-/// `s = C q + e`.
-fn slip_field(
+/// The slip field `s = C q + e` of tractions `q` (`e`: the coupling term,
+/// or minus the last state's displacement, if any).
+pub(crate) fn slip_field(
     op: &mut Operator,
     extra: Option<(&[f64], &[f64])>,
     (qx, qy): (&[f64], &[f64]),
@@ -686,7 +673,7 @@ pub(crate) fn active_set(
     // κ of the start. Its force is met and its stick cells are within their
     // bounds (the caller's projection), so it is frozen only if it needs a
     // PCG run: a warm start at the tolerance costs one application.
-    let Some((_, d, _)) = w.kkt(&sp, ctl.floor, (qx, qy), (sx, sy)) else {
+    let Some((_, d, _)) = w.kkt(&sp, ctl.floor, (qx, qy), (sx, sy), false) else {
         return Ok(w.out);
     };
     for &i in cells {
@@ -709,7 +696,7 @@ pub(crate) fn active_set(
     // Consecutive acceptance tests the exact measure failed.
     let mut misses = 0;
     loop {
-        let Some((e, d, scale)) = w.kkt(&sp, ctl.floor, (qx, qy), (sx, sy)) else {
+        let Some((e, d, scale)) = w.kkt(&sp, ctl.floor, (qx, qy), (sx, sy), false) else {
             return Ok(w.out);
         };
         w.out.shift = d;
@@ -736,7 +723,7 @@ pub(crate) fn active_set(
                 slip_field(op, w.extra, (qx, qy), (sx, sy));
                 w.out.applications += 1;
             }
-            let Some((ek, dk, sk)) = w.kkt_exact(&sp, ctl.floor, (qx, qy), (sx, sy)) else {
+            let Some((ek, dk, sk)) = w.kkt(&sp, ctl.floor, (qx, qy), (sx, sy), true) else {
                 return Ok(w.out);
             };
             w.out.kkt = ek;
@@ -869,7 +856,7 @@ fn pcg(
         w.out.iterations += 1;
         if php <= 0.0 || !php.is_finite() || rz <= 0.0 {
             return Ok(last.or_else(|| {
-                w.kkt(sp, ctl.floor, (qx, qy), (sx, sy))
+                w.kkt(sp, ctl.floor, (qx, qy), (sx, sy), false)
                     .map(|(_, d, s)| (d, s))
             }));
         }
@@ -882,7 +869,7 @@ fn pcg(
             sx[i] += alpha * cx[i];
             sy[i] += alpha * cy[i];
         }
-        let Some((e, dn, sn)) = w.kkt(sp, ctl.floor, (qx, qy), (sx, sy)) else {
+        let Some((e, dn, sn)) = w.kkt(sp, ctl.floor, (qx, qy), (sx, sy), false) else {
             return Ok(None);
         };
         last = Some((dn, sn));

@@ -22,29 +22,13 @@ use crate::base::parallel::{Chunks, Threads};
 use crate::error::SolverError;
 use crate::operators::multilevel::FourierPrecond;
 use crate::operators::operator::Operator;
-use crate::solve::active_set::{active_set, norm, solve2, Controls, Feasible};
+use crate::solve::active_set::{active_set, norm, slip_field, solve2, Controls, Feasible};
 use crate::solve::coarse_slip::{coarse_start, TangentialLevels};
 use crate::solve::fista::{self, Momentum};
 pub use crate::solve::tangential_problem::{
     TangentialMethod, TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
 };
 use crate::solve::window::{contact_window, WindowCache};
-
-/// The slip field `s = C q + e` of tractions `q` (`e`: the coupling term, if any).
-fn slip_field(
-    op: &mut Operator,
-    extra: Option<(&[f64], &[f64])>,
-    (qx, qy): (&[f64], &[f64]),
-    (sx, sy): (&mut [f64], &mut [f64]),
-) {
-    op.tangential(qx, qy, sx, sy);
-    if let Some((ex, ey)) = extra {
-        for i in 0..sx.len() {
-            sx[i] += ex[i];
-            sy[i] += ey[i];
-        }
-    }
-}
 
 /// Exact projection of `z` onto the feasible set: q_i = Π_i(z_i + λ).
 /// Returns `None` if no λ satisfies the force (gross sliding).

@@ -1,7 +1,13 @@
 //! Shared set-up of the validation tests: the paper's Table 1a case.
 #![allow(dead_code)]
 
+use solver::influence::isotropic_cell;
+use solver::normal::{solve_normal, NormalCache, NormalProblem};
+use solver::tangential::{
+    TangentialMethod, TangentialProblem, TangentialSolution, TangentialStart,
+};
 use solver::Material;
+use solver::Operator;
 use solver::Surface;
 use solver::{CaseSpec, Grid, Load, Numerics};
 
@@ -79,4 +85,84 @@ pub fn cu_123() -> Material {
         None,
     )
     .unwrap()
+}
+
+/// Table 1a's normal load, N, and friction coefficient.
+pub const LOAD_1A: f64 = 20.0;
+/// See [`LOAD_1A`].
+pub const MU_1A: f64 = 0.28571;
+
+/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm at Table 1a's load:
+/// the Hertz pressure on an `n x n` grid of cell `d`, and the operator.
+pub fn hertz_fe(n: usize, d: f64) -> (Operator, Vec<f64>) {
+    let grid = Grid { n, dx: d, dy: d };
+    let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
+    let g = e / (2.0 * (1.0 + nu));
+    let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
+    let h: Vec<f64> = (0..grid.len())
+        .map(|i| {
+            let (x, y) = (grid.x(i % n), grid.y(i / n));
+            (x * x + y * y) / (2.0 * r)
+        })
+        .collect();
+    let mut cache = NormalCache::new(&mut op);
+    let p = solve_normal(&mut op, &mut cache, &NormalProblem::new(&h, LOAD_1A))
+        .unwrap()
+        .p;
+    (op, p)
+}
+
+/// Two tangential solutions of the pressure `p` compared: max |Δq| / (μ
+/// p_max), |Δδt| / |δt| and the number of cells whose stick state differs.
+pub fn tangential_difference(
+    a: &TangentialSolution,
+    b: &TangentialSolution,
+    p: &[f64],
+) -> (f64, f64, usize) {
+    let pmax = p.iter().cloned().fold(0.0, f64::max);
+    let dq = (0..p.len())
+        .map(|i| (a.qx[i] - b.qx[i]).hypot(a.qy[i] - b.qy[i]))
+        .fold(0.0, f64::max)
+        / (MU_1A * pmax);
+    let dt =
+        (a.shift[0] - b.shift[0]).hypot(a.shift[1] - b.shift[1]) / a.shift[0].hypot(a.shift[1]);
+    let stick = (0..p.len()).filter(|&i| a.stick[i] != b.stick[i]).count();
+    (dq, dt, stick)
+}
+
+/// The quick sweep's conditions (Table 1c: R = 200 mm, P = 6 kN, μ = 0.3,
+/// 128² of 60 µm), F = 0.6 μP along `angle_deg`, coupled, one step.
+pub fn quick_1c(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
+    CaseSpec {
+        material: solver::presets::material(material).unwrap(),
+        surface: solver::presets::surface(surface).unwrap(),
+        grid: Grid::square(128, 60e-6),
+        load: Load {
+            indenter_radius_m: 0.2,
+            normal_force_n: 6000.0,
+            friction: 0.3,
+            tangential_ratio: 0.6,
+            angle_deg,
+        },
+        numerics: Numerics::default(),
+        history: None,
+        indenter: None,
+    }
+}
+
+/// Cattaneo's step on the pressure `p` of [`hertz_fe`]: F = 0.6 μP along x
+/// from rest, KKT tolerance 1e-6, by `method`.
+pub fn cattaneo_problem(p: &[f64], method: TangentialMethod) -> TangentialProblem<'_> {
+    TangentialProblem {
+        p,
+        friction: MU_1A,
+        force: [0.6 * MU_1A * LOAD_1A, 0.0],
+        extra: None,
+        tolerance: 1e-6,
+        slip_floor: 0.0,
+        max_iterations: 5000,
+        start: TangentialStart::Proportional,
+        precondition: false,
+        method,
+    }
 }
