@@ -58,18 +58,18 @@ pub fn stress_kernels(cfg: &crate::config::StressCfg) -> usize {
 /// (the padded grid's spectra; the transforms' log N aside), from
 /// `mpcontact solve --threads 1` of Table 1(a) on 256² cells of 1 µm with
 /// and without `depths_um = [10, 25]` and the default slices (issue #51,
-/// docs/performance.md: 1.72 and 1.82 s more for Fe, 2.49 and 2.64 s for
-/// Fe(111)): the surface plane 0.9 s (the example `stress_cost`), each
-/// deeper plane 0.06 s, each slice row the rest, 0.018 s, for Fe; a
-/// crystal 1.45 times that. The surface plane is counted in every case: a
-/// sweep's worker builds it once per material and grid, so a sweep's
-/// estimate is an upper bound (Table 1(a), 8 cases on one worker: 13 s
-/// more measured, 17 s estimated).
+/// docs/performance.md: 1.72, 1.82 and 1.74 s more for Fe, 1.85 s for
+/// Fe(111) with its roots interpolated): the surface plane 0.9 s (the
+/// example `stress_cost`), each deeper plane 0.06 s, each slice row the
+/// rest, 0.018 s, for Fe; a crystal 1.05 times that. The surface plane is
+/// counted in every case: a sweep's worker builds it once per material and
+/// grid, so a sweep's estimate is an upper bound (Table 1(a), 8 cases on
+/// one worker: 8.7–11.2 s more measured, 14.4 s estimated).
 pub fn stress_seconds(spec: &CaseSpec, cfg: &crate::config::StressCfg) -> f64 {
     const SURFACE_S: f64 = 0.9;
     const PLANE_S: f64 = 0.06;
     const ROW_S: f64 = 0.018;
-    const CRYSTAL: f64 = 1.45;
+    const CRYSTAL: f64 = 1.05;
     let planes = cfg.depths_um.iter().filter(|&&z| z != 0.0).count() as f64;
     let rows = if cfg.slices {
         cfg.slice_rows as f64
