@@ -26,18 +26,22 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
 }
 
 /// Estimated extra peak bytes of `[stress]` in a worker on an `n x n` grid
-/// (counted from the arrays, B per cell): one depth kernel at a time (18
-/// spectra of the padded grid, 576), the transforms' scratch (256), per
-/// state the traction spectra (96) and its planes (48 each, the surface's
-/// for SWT included), and the Crossland and SWT maps (8 each). 256², Fe,
-/// one state, one plane and 25 slice rows: 115 MB with the solve's 46;
-/// measured peak of `mpcontact solve --threads 1` 107 MB (35.5 MB without
-/// the section; docs/validation.md).
+/// (counted from the arrays, B per cell): the surface's depth kernel, which
+/// a worker keeps between cases (`solver::stress_summary::StressCache`),
+/// and one more at a time for the other planes and the slice rows (18
+/// spectra of the padded grid, 576 each), the transforms' scratch (256),
+/// per state the traction spectra (96) and its planes (48 each, the
+/// surface's for SWT included), and the Crossland and SWT maps (8 each).
+/// 256², Fe, one state, one plane and 25 slice rows: 152 MB with the
+/// solve's 46 (before issue #51 one kernel lived at a time: 115 MB
+/// estimated, 107 MB measured peak of `mpcontact solve --threads 1`).
 pub fn stress_bytes(n: usize, cfg: &crate::config::StressCfg, states: usize) -> f64 {
     let cells = (n * n) as f64;
     let planes = (cfg.depths_um.len() + 1) as f64;
+    let deeper = cfg.slices || cfg.depths_um.iter().any(|&z| z != 0.0);
+    let kernels = if deeper { 2.0 } else { 1.0 };
     let states = states.max(1) as f64;
-    cells * (576.0 + 256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
+    cells * (576.0 * kernels + 256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
 }
 
 /// The most states a case of `cases` has its stresses computed at (the

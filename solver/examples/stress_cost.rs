@@ -1,7 +1,11 @@
-//! What the stresses below the surface cost (docs/performance.md, issue
-//! #38): the plan of a material, the kernel of one depth plane, the three
-//! traction transforms of a state, a full plane and one line (a row of an
-//! x–z slice), for an isotropic and a (111) substrate.
+//! What the stresses below the surface cost (docs/performance.md, issues
+//! #38 and #51): the plan of a material, the kernel of one depth plane, the
+//! three traction transforms of a state, a full plane and one line (a row
+//! of an x–z slice), and an x–z slice of 41 rows as `stress_summary` makes
+//! it (the surface row from the surface plane, the rows within the
+//! aliases' reach from their planes, the deeper ones together without
+//! planes), with the surface plane built and kept (a sweep's later cases),
+//! for an isotropic and a (111) substrate.
 //!
 //! `cargo run --release -p mpcontact-solver --example stress_cost -- [N ...]`
 
@@ -19,8 +23,8 @@ fn main() {
     } else {
         sizes
     };
-    println!("| material | n | plan s | plane kernel s (z = 0.5a) | plane kernel s (z = 0) | tractions s | apply plane s | apply line s | slice of 41 rows s |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("| material | n | plan s | plane kernel s (z = 0.5a) | plane kernel s (z = 0) | tractions s | apply plane s | apply line s | slice of 41 rows s | the same, surface plane kept s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for name in ["Fe", "Fe(111)"] {
         let material = presets::material(name).unwrap();
         for &n in &sizes {
@@ -49,7 +53,6 @@ fn main() {
             let t0 = Instant::now();
             let surface = plan.plane(0.0).unwrap();
             let t_kernel0 = t0.elapsed().as_secs_f64();
-            drop(surface);
             let t0 = Instant::now();
             let t = plan.tractions(&p, &qx, &qy);
             let t_tr = t0.elapsed().as_secs_f64();
@@ -61,17 +64,39 @@ fn main() {
             let t_line = t0.elapsed().as_secs_f64();
             assert_eq!(f.len(), n * n);
             assert_eq!(l.len(), n);
-            // A slice: one kernel per row (the shallow rows with aliases).
+            // A slice as stress_summary makes it.
             let rows = 41;
-            let t0 = Instant::now();
-            for k in 0..rows {
-                let z = 2.0 * a * k as f64 / (rows - 1) as f64;
-                let pl = plan.plane(z).unwrap();
-                let _ = plan.apply_line(&pl, &t, Line::Row(n / 2));
-            }
-            let t_slice = t0.elapsed().as_secs_f64();
+            let depths: Vec<f64> = (0..rows)
+                .map(|k| 2.0 * a * k as f64 / (rows - 1) as f64)
+                .collect();
+            let states = [t];
+            let mut slice = |surface: Option<&solver::stress::StressPlane>| {
+                let t0 = Instant::now();
+                let own;
+                let top = match surface {
+                    Some(s) => s,
+                    None => {
+                        own = plan.plane(0.0).unwrap();
+                        &own
+                    }
+                };
+                let _ = plan.apply_line(top, &states[0], Line::Row(n / 2));
+                let mut deep = Vec::new();
+                for &z in &depths[1..] {
+                    if plan.sums_aliases(z) {
+                        let pl = plan.plane(z).unwrap();
+                        let _ = plan.apply_line(&pl, &states[0], Line::Row(n / 2));
+                    } else {
+                        deep.push(z);
+                    }
+                }
+                let _ = plan.slice(&deep, &states, &[Line::Row(n / 2)]).unwrap();
+                t0.elapsed().as_secs_f64()
+            };
+            let t_slice = slice(None);
+            let t_slice_kept = slice(Some(&surface));
             println!(
-                "| {name} | {n} | {t_plan:.2} | {t_kernel:.2} | {t_kernel0:.2} | {t_tr:.3} | {t_apply:.3} | {t_line:.3} | {t_slice:.1} |"
+                "| {name} | {n} | {t_plan:.2} | {t_kernel:.3} | {t_kernel0:.2} | {t_tr:.3} | {t_apply:.3} | {t_line:.3} | {t_slice:.2} | {t_slice_kept:.2} |"
             );
         }
     }

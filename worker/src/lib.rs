@@ -32,7 +32,7 @@ use protocol::{
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
-use solver::stress_summary::{StressRequest, StressScalars};
+use solver::stress_summary::{StressCache, StressRequest, StressScalars};
 use solver::{solve_case, CaseScalars, CaseSpec, KernelCache, KernelKey};
 
 /// Case specification as it travels on the wire: the case, and what of
@@ -170,6 +170,9 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
     solver::set_tick_hook(Some(Box::new(move || ticking.borrow_mut().tick())));
     let mut cache = kernel_store::FileStore::cache();
     let mut keys: HashSet<KernelKey> = HashSet::new();
+    // The stress plan and fixed-depth planes of the last material and grid
+    // (`[stress]`), shared by the cases that follow.
+    let mut stress_cache = StressCache::new();
     let mut next: WorkerMessage<K> = ToCoord::Ready(Ready {
         worker_index: worker_index as u32,
         pid: std::process::id(),
@@ -197,7 +200,13 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
                 heartbeat.borrow_mut().beat();
                 #[cfg(feature = "fault-injection")]
                 fault_injection::before_solve(&case.key.to_string());
-                let (msg, fields) = solve_one(&case, worker_index, &mut cache, &mut keys);
+                let (msg, fields) = solve_one(
+                    &case,
+                    worker_index,
+                    &mut cache,
+                    &mut keys,
+                    &mut stress_cache,
+                );
                 next = msg;
                 fields_buf = fields;
             }
@@ -228,6 +237,7 @@ fn solve_one<K: WireKey>(
     worker_index: usize,
     cache: &mut KernelCache,
     keys: &mut HashSet<KernelKey>,
+    stress_cache: &mut StressCache,
 ) -> (WorkerMessage<K>, Option<solver::Fields>) {
     let start = Instant::now();
     keys.insert(KernelKey::of(&case.spec.case));
@@ -236,12 +246,13 @@ fn solve_one<K: WireKey>(
         // same function `mpcontact solve` calls, on the same inputs.
         let stress = match &case.spec.stress {
             Some(req) => Some(
-                solver::stress_summary::compute(
+                solver::stress_summary::compute_with(
                     req,
                     &case.spec.case,
                     &out.scalars,
                     &out.fields,
                     &out.turning,
+                    stress_cache,
                 )?
                 .scalars,
             ),
@@ -514,7 +525,13 @@ mod tests {
             ("B/flat/000.0", spec("B", 200e9, 0.0)),
             ("A/flat/090.0", spec("A", 130e9, 90.0)),
         ] {
-            let (msg, fields) = solve_one(&assignment(id, s, false), 3, &mut cache, &mut keys);
+            let (msg, fields) = solve_one(
+                &assignment(id, s, false),
+                3,
+                &mut cache,
+                &mut keys,
+                &mut StressCache::new(),
+            );
             assert!(fields.is_none());
             match msg {
                 ToCoord::Result(h) => {
@@ -538,6 +555,7 @@ mod tests {
             0,
             &mut cache,
             &mut keys,
+            &mut StressCache::new(),
         );
         let ToCoord::Result(h) = msg else {
             panic!("not a result")
@@ -576,6 +594,7 @@ mod tests {
             0,
             &mut cache,
             &mut keys,
+            &mut StressCache::new(),
         );
         match msg {
             ToCoord::Failed(f) => assert!(f.error.contains("tangential_ratio"), "{}", f.error),

@@ -16,8 +16,11 @@
 //! resolve, and the product applied by FFT on the zero-padded `2n x 2n`
 //! grid (DC-FFT's padding). Sampled in frequency, that kernel still carries
 //! its periodic images at the padded period; they are estimated on a coarse
-//! grid and subtracted ([`StressPlan::plane`]), so the convolution is the
-//! non-periodic one of DC-FFT.
+//! grid and subtracted there in real space (`StressPlan::images`), so the
+//! convolution is the non-periodic one of DC-FFT. Per direction the
+//! response is tabulated in Putzer's form (`Node`), so a depth costs an
+//! exponential per root, not a matrix exponential (issue #51); a slice's
+//! rows are summed into their lines without planes ([`StressPlan::slice`]).
 
 use nalgebra::{Matrix3, Matrix6, SMatrix};
 use num_complex::Complex64;
@@ -93,14 +96,193 @@ impl Direction {
     }
 }
 
-/// How a material responds at depth: `P`, `W`, `H` (and `P H`) tabulated
-/// over the directions, interpolated between them (4-point Lagrange).
+/// How a material responds at depth, tabulated over the directions: at
+/// each node the response in Putzer's form ([`Node`]), exact for any
+/// `s = ρz`; between nodes the responses of the four nearest are combined
+/// (4-point Lagrange in θ).
 struct Response {
-    /// Isotropic: `H` of §3 at the nodes and `W = −iI + N` with `N² = 0`,
-    /// so that `exp(−isW) = e^{−s}(I − isN)`. Otherwise Stroh: `H` from the
-    /// Barnett–Lothe integrals, the exponential by scaling and squaring.
+    /// Isotropic: every node has the triple root `−i` and `Q₂ = 0`
+    /// (`(W + iI)² = 0`), so the four nodes share one set of coefficients.
     isotropic: bool,
+    nodes: Vec<Node>,
+    /// Per stencil (its first node): the roots and matrices of a crystal
+    /// vary smoothly over its four nodes, so that they may be interpolated
+    /// themselves and one node's exponentials serve a frequency (the roots
+    /// of consecutive nodes are ordered alike; a stencil through a
+    /// crossing of roots, or where the ordering wraps at 2π, is not).
+    smooth: Vec<bool>,
+    /// `P`, `W`, `H` of the nodes: the construction before issue #51
+    /// (interpolate them, then `exp(−isW)` per frequency), kept as the
+    /// tests' oracle.
+    #[cfg(test)]
     table: Vec<Direction>,
+}
+
+/// Series of [`phi1`] and [`divided`] below this `|x|·spread`: 16 terms
+/// leave below `0.5¹⁶/17!`, and the difference quotients above it lose at
+/// most a factor `1/0.5` to cancellation.
+const CLUSTER: f64 = 0.5;
+
+/// `φ₁(u) = (eᵘ − 1)/u` for `|u| < CLUSTER` (series).
+fn phi1(u: C) -> C {
+    let (mut sum, mut term) = (C::new(0.0, 0.0), C::new(1.0, 0.0));
+    for k in 1..=16 {
+        term /= k as f64;
+        sum += term;
+        term *= u;
+    }
+    sum
+}
+
+/// One tabulated direction θ in Putzer's form: with `λ₁, λ₂, λ₃` the
+/// eigenvalues of `W` (the Stroh roots) and `g(λ) = e^{−isλ}`,
+/// `P exp(−isW) H = g[λ₁] Q₀ + g[λ₁,λ₂] Q₁ + g[λ₁,λ₂,λ₃] Q₂` with
+/// `Q₀ = PH`, `Q₁ = P(W − λ₁)H`, `Q₂ = P(W − λ₁)(W − λ₂)H` and `g[…]`
+/// divided differences (Cayley–Hamilton: exact for any `W`, defective or
+/// not, which an eigenvector route is not). Per depth it costs three
+/// exponentials and 54 products instead of a matrix exponential.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    lam: [C; 3],
+    /// Largest distance between two roots.
+    spread: f64,
+    /// The pairs `(0, 1), (0, 2), (1, 2)`: `|λⱼ − λᵢ|` and `1/(λⱼ − λᵢ)`
+    /// (0 for equal roots, never used then).
+    gap: [f64; 3],
+    inv: [C; 3],
+    /// The pair `(p, q)` farthest apart (an index into [`PAIRS`]) and the
+    /// pairs `(r, q)`, `(r, p)` of the third root `r` with it.
+    far: usize,
+    ends: [usize; 2],
+    /// `Q₀, Q₁, Q₂`, each 6x3 row major (`[3·row + column]`).
+    q: [[C; 18]; 3],
+}
+
+/// The root pairs of [`Node::gap`] and the root outside each.
+const PAIRS: [(usize, usize, usize); 3] = [(0, 1, 2), (0, 2, 1), (1, 2, 0)];
+
+fn flat(m: &M63) -> [C; 18] {
+    std::array::from_fn(|c| m[(c / 3, c % 3)])
+}
+
+impl Node {
+    /// The node of direction `d`, its roots in the order nearest `prev`'s
+    /// (the previous node's) when given.
+    fn new(d: &Direction, isotropic: bool, prev: Option<&[C; 3]>) -> Result<Self, SolverError> {
+        let i = M3::identity();
+        let (lam, q) = if isotropic {
+            let nil = d.w + i * C::new(0.0, 1.0);
+            let q = [flat(&d.ph), flat(&(d.p * nil * d.h)), [C::default(); 18]];
+            ([C::new(0.0, -1.0); 3], q)
+        } else {
+            let ev = d.w.eigenvalues().ok_or_else(|| {
+                SolverError::invalid(
+                    "material",
+                    "the Stroh matrix of a direction has no eigenvalues (stresses below the surface)",
+                )
+            })?;
+            let mut lam = [ev[0], ev[1], ev[2]];
+            if let Some(prev) = prev {
+                const ORDERS: [[usize; 3]; 6] = [
+                    [0, 1, 2],
+                    [0, 2, 1],
+                    [1, 0, 2],
+                    [1, 2, 0],
+                    [2, 0, 1],
+                    [2, 1, 0],
+                ];
+                let cost =
+                    |o: &[usize; 3]| -> f64 { (0..3).map(|k| (lam[o[k]] - prev[k]).norm()).sum() };
+                let best = ORDERS
+                    .iter()
+                    .min_by(|a, b| cost(a).total_cmp(&cost(b)))
+                    .expect("six orders");
+                lam = best.map(|k| lam[k]);
+            }
+            let a = d.w - i * lam[0];
+            let b = a * (d.w - i * lam[1]);
+            let q = [flat(&d.ph), flat(&(d.p * a * d.h)), flat(&(d.p * b * d.h))];
+            (lam, q)
+        };
+        Ok(Node::with(lam, q))
+    }
+
+    /// The node of roots `lam` and matrices `q`.
+    fn with(lam: [C; 3], q: [[C; 18]; 3]) -> Self {
+        let gap = PAIRS.map(|(a, b, _)| (lam[b] - lam[a]).norm());
+        let inv = PAIRS.map(|(a, b, _)| {
+            let d = lam[b] - lam[a];
+            if d.norm_sqr() > 0.0 {
+                d.inv()
+            } else {
+                C::default()
+            }
+        });
+        let far = (0..3)
+            .max_by(|&a, &b| gap[a].total_cmp(&gap[b]))
+            .expect("three pairs");
+        let (p, q2, r) = PAIRS[far];
+        let index = |a: usize, b: usize| {
+            PAIRS
+                .iter()
+                .position(|&(i, j, _)| (i, j) == (a.min(b), a.max(b)))
+                .expect("a pair of distinct roots")
+        };
+        Node {
+            lam,
+            spread: gap[far],
+            gap,
+            inv,
+            far,
+            ends: [index(r, q2), index(r, p)],
+            q,
+        }
+    }
+}
+
+/// Putzer's coefficients `g[λ₁], g[λ₁,λ₂], g[λ₁,λ₂,λ₃]` of
+/// `g(λ) = e^{−isλ}` (divided differences) at `node`, stable for close and
+/// equal roots: a series where the roots are within `CLUSTER/s` of each
+/// other, difference quotients of exponentials that all decay (no
+/// overflow) elsewhere.
+fn divided(s: f64, node: &Node) -> [C; 3] {
+    let x = C::new(0.0, -s);
+    divided_with(s, node, &node.lam.map(|l| (x * l).exp()))
+}
+
+/// [`divided`] from the exponentials `e^{−isλ}` of the three roots (a
+/// slice's rows step them by one product each).
+fn divided_with(s: f64, node: &Node, e: &[C; 3]) -> [C; 3] {
+    let x = C::new(0.0, -s);
+    let lam = &node.lam;
+    let e1 = e[0];
+    if s * node.spread < CLUSTER {
+        // g[λ₁,λ₂] = e^{xλ₁} x φ₁(u), g[λ₁,λ₂,λ₃] = e^{xλ₁} x² Σ h_k(u,v)/(k+2)!,
+        // u = x(λ₂ − λ₁), v = x(λ₃ − λ₁), h_k the complete symmetric polynomial.
+        let (u, v) = (x * (lam[1] - lam[0]), x * (lam[2] - lam[0]));
+        let (mut h, mut vk, mut fact) = (C::new(1.0, 0.0), C::new(1.0, 0.0), 2.0);
+        let mut psi = C::new(0.0, 0.0);
+        for k in 0..16 {
+            psi += h / fact;
+            vk *= v;
+            h = u * h + vk;
+            fact *= (k + 3) as f64;
+        }
+        return [e1, e1 * x * phi1(u), e1 * x * x * psi];
+    }
+    // g[λᵢ, λⱼ] of pair k.
+    let two = |k: usize| {
+        let (i, j, _) = PAIRS[k];
+        if s * node.gap[k] < CLUSTER {
+            e[i] * x * phi1(x * (lam[j] - lam[i]))
+        } else {
+            (e[j] - e[i]) * node.inv[k]
+        }
+    };
+    // The third from the pair farthest apart (s·|λq − λp| ≥ CLUSTER):
+    // g[λr, λp, λq] = (g[λr, λq] − g[λr, λp]) / (λq − λp).
+    let [rq, rp] = node.ends;
+    [e1, two(0), (two(rq) - two(rp)) * node.inv[node.far]]
 }
 
 /// The isotropic surface compliance of PHYSICS.md §3.
@@ -125,6 +307,8 @@ fn isotropic_h(g: f64, nu: f64, theta: f64) -> M3 {
 /// `exp(x)` of a 3x3 complex matrix: scaling and squaring of a 14-term
 /// Taylor series (the scaled norm is at most 1/2, so the truncation is
 /// below 3e-17). Exact for defective matrices, which an eigenvector route is not.
+/// The tests' oracle for [`Node`]'s exponential.
+#[cfg(test)]
 pub(crate) fn expm3(x: &M3) -> M3 {
     let norm = (0..3)
         .map(|j| (0..3).map(|i| x[(i, j)].norm()).sum::<f64>())
@@ -148,12 +332,74 @@ pub(crate) fn expm3(x: &M3) -> M3 {
     sum
 }
 
+/// Largest fourth difference of a node's roots and matrices, relative to
+/// their size, below which a stencil counts as smooth: 4-point Lagrange
+/// then errs by about `3/128` of it, 2e-8 (at 4e-8, for an error of 1e-9,
+/// only 65 % of Fe(111)'s stencils qualified: a harmonic of order 6 in θ
+/// alone has a fourth difference of 1e-7 at 2048 nodes; a crossing of
+/// roots or their order wrapping at 2π gives one of order 1).
+const SMOOTH_DIFFERENCE: f64 = 1e-6;
+
+/// [`Response::smooth`] of a crystal's nodes: every value of each of the
+/// four nodes of a stencil (with two more either side) has a small fourth
+/// difference.
+fn smooth_stencils(nodes: &[Node]) -> Vec<bool> {
+    let k = nodes.len() as i64;
+    let at = |i: i64| &nodes[i.rem_euclid(k) as usize];
+    // Fourth difference centred on node i, relative.
+    let rough: Vec<bool> = (0..k)
+        .map(|i| {
+            let w = [1.0, -4.0, 6.0, -4.0, 1.0];
+            let diff = |f: &dyn Fn(&Node) -> C| -> C {
+                (0..5).map(|j| f(at(i - 2 + j as i64)) * w[j]).sum()
+            };
+            let scale_l = at(i).lam.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            let lam_rough =
+                (0..3).any(|r| diff(&|n: &Node| n.lam[r]).norm() > SMOOTH_DIFFERENCE * scale_l);
+            let q_rough = (0..3).any(|kk| {
+                let scale = at(i).q[kk].iter().map(|v| v.norm()).fold(0.0, f64::max);
+                (0..18).any(|c| {
+                    diff(&|n: &Node| n.q[kk][c]).norm() > SMOOTH_DIFFERENCE * scale.max(1e-300)
+                })
+            });
+            lam_rough || q_rough
+        })
+        .collect();
+    (0..k)
+        .map(|s| (0..4).all(|j| !rough[(s + j).rem_euclid(k) as usize]))
+        .collect()
+}
+
+impl Response {
+    /// One node interpolated between the four of a smooth stencil (its
+    /// roots and matrices), or `None` off a smooth stencil.
+    fn interpolated(&self, nodes: &[(usize, f64); 4]) -> Option<Node> {
+        if self.isotropic || !self.smooth[nodes[0].0] {
+            return None;
+        }
+        let mut lam = [C::default(); 3];
+        let mut q = [[C::default(); 18]; 3];
+        for &(i, w) in nodes {
+            let n = &self.nodes[i];
+            for (a, b) in lam.iter_mut().zip(&n.lam) {
+                *a += b * w;
+            }
+            for (qa, qb) in q.iter_mut().zip(&n.q) {
+                for (a, b) in qa.iter_mut().zip(qb) {
+                    *a += b * w;
+                }
+            }
+        }
+        Some(Node::with(lam, q))
+    }
+}
+
 impl Response {
     fn of(material: &Material) -> Result<Self, SolverError> {
         let cv = material.stiffness();
         let t = voigt_to_tensor(&cv);
         let theta = |k: usize| 2.0 * std::f64::consts::PI * k as f64 / STROH_DIRECTIONS as f64;
-        let (isotropic, table) = match &material.elasticity {
+        let (isotropic, table): (bool, Vec<Direction>) = match &material.elasticity {
             Elasticity::Isotropic(iso) => {
                 if iso.poisson >= 0.5 {
                     return Err(SolverError::invalid(
@@ -181,12 +427,28 @@ impl Response {
                 (false, table)
             }
         };
-        Ok(Response { isotropic, table })
+        let mut nodes: Vec<Node> = Vec::with_capacity(table.len());
+        for d in &table {
+            let prev = nodes.last().map(|n| n.lam);
+            nodes.push(Node::new(d, isotropic, prev.as_ref())?);
+        }
+        let smooth = if isotropic {
+            vec![false; nodes.len()]
+        } else {
+            smooth_stencils(&nodes)
+        };
+        Ok(Response {
+            isotropic,
+            nodes,
+            smooth,
+            #[cfg(test)]
+            table,
+        })
     }
 
     /// The nodes and 4-point Lagrange weights of direction θ.
     fn nodes(&self, theta: f64) -> [(usize, f64); 4] {
-        let k = self.table.len();
+        let k = self.nodes.len();
         let u =
             theta.rem_euclid(2.0 * std::f64::consts::PI) / (2.0 * std::f64::consts::PI) * k as f64;
         let i0 = u.floor() as i64;
@@ -200,6 +462,84 @@ impl Response {
         std::array::from_fn(|j| ((i0 - 1 + j as i64).rem_euclid(k as i64) as usize, wts[j]))
     }
 
+    /// `P H` along θ: the response at `s = 0`.
+    fn surface(&self, theta: f64) -> [C; 18] {
+        let mut ph = [C::default(); 18];
+        for (i, wt) in self.nodes(theta) {
+            for (a, q) in ph.iter_mut().zip(&self.nodes[i].q[0]) {
+                *a += q * wt;
+            }
+        }
+        ph
+    }
+
+    /// Stress per unit traction `σ̂ = M t̂` (6x3 row major) at wave vector
+    /// `(ex, ey)` and depth `z`.
+    fn at(&self, ex: f64, ey: f64, z: f64) -> [C; 18] {
+        let theta = ey.atan2(ex);
+        if z == 0.0 {
+            return self.surface(theta);
+        }
+        // (not `hypot`: its care for overflow took 13 % of a plane's time)
+        let s = (ex * ex + ey * ey).sqrt() * z;
+        let mut acc = [C::default(); 18];
+        if self.isotropic {
+            // One set of coefficients for the four nodes (their roots are
+            // all −i): g[λ] = e^{−s}, g[λ, λ] = −is e^{−s}.
+            let decay = (-s).exp();
+            for (i, wt) in self.nodes(theta) {
+                let (r, m) = (decay * wt, -s * decay * wt);
+                let q = &self.nodes[i].q;
+                for (c, a) in acc.iter_mut().enumerate() {
+                    // q₀ r + q₁ (i m)
+                    a.re += q[0][c].re * r - q[1][c].im * m;
+                    a.im += q[0][c].im * r + q[1][c].re * m;
+                }
+            }
+        } else {
+            let nodes = self.nodes(theta);
+            match self.interpolated(&nodes) {
+                // One node's exponentials where the roots interpolate.
+                Some(node) => {
+                    let g = divided(s, &node);
+                    for (c, a) in acc.iter_mut().enumerate() {
+                        *a = node.q[0][c] * g[0] + node.q[1][c] * g[1] + node.q[2][c] * g[2];
+                    }
+                }
+                None => {
+                    for (i, wt) in nodes {
+                        let node = &self.nodes[i];
+                        let g = divided(s, node).map(|v| v * wt);
+                        for (c, a) in acc.iter_mut().enumerate() {
+                            *a += node.q[0][c] * g[0] + node.q[1][c] * g[1] + node.q[2][c] * g[2];
+                        }
+                    }
+                }
+            }
+        }
+        acc
+    }
+
+    /// The response at `η = 0`: its limit depends on the direction; the
+    /// mean over directions (the in-plane rows; the `z` rows are `−I` along
+    /// every direction).
+    fn mean_at_zero(&self) -> [C; 18] {
+        let k = 64;
+        let mut acc = [C::default(); 18];
+        for i in 0..k {
+            let s = self.surface(2.0 * std::f64::consts::PI * i as f64 / k as f64);
+            for (a, v) in acc.iter_mut().zip(s) {
+                *a += v / k as f64;
+            }
+        }
+        acc
+    }
+}
+
+/// The construction before issue #51 (interpolate `P`, `W`, `H`, then the
+/// exponential per frequency): the oracle of the tests.
+#[cfg(test)]
+impl Response {
     /// `P`, `W`, `H` along θ.
     fn direction(&self, theta: f64) -> Direction {
         let mut d = Direction {
@@ -214,20 +554,12 @@ impl Response {
             d.p += node.p * c;
             d.w += node.w * c;
             d.h += node.h * c;
+            d.ph += node.ph * c;
         }
         d
     }
 
-    /// `P H` along θ: the response at `s = 0`.
-    fn surface(&self, theta: f64) -> M63 {
-        let mut ph = M63::zeros();
-        for (i, wt) in self.nodes(theta) {
-            ph += self.table[i].ph * C::new(wt, 0.0);
-        }
-        ph
-    }
-
-    /// `exp(−isW)` for this response.
+    /// `exp(−isW)`.
     fn propagator(&self, d: &Direction, s: f64) -> M3 {
         if s == 0.0 {
             return M3::identity();
@@ -240,26 +572,13 @@ impl Response {
         }
     }
 
-    /// Stress per unit traction `σ̂ = M t̂` (6x3) at wave vector `(ex, ey)` and depth `z`.
-    fn at(&self, ex: f64, ey: f64, z: f64) -> M63 {
-        let theta = ey.atan2(ex);
+    /// `σ̂ = M t̂` the old way.
+    fn reference_at(&self, ex: f64, ey: f64, z: f64) -> M63 {
+        let d = self.direction(ey.atan2(ex));
         if z == 0.0 {
-            return self.surface(theta);
+            return d.ph;
         }
-        let d = self.direction(theta);
         d.p * self.propagator(&d, ex.hypot(ey) * z) * d.h
-    }
-
-    /// The response at `η = 0`: its limit depends on the direction; the
-    /// mean over directions (the in-plane rows; the `z` rows are `−I` along
-    /// every direction).
-    fn mean_at_zero(&self) -> M63 {
-        let k = 64;
-        let mut acc = M63::zeros();
-        for i in 0..k {
-            acc += self.surface(2.0 * std::f64::consts::PI * i as f64 / k as f64);
-        }
-        acc / C::new(k as f64, 0.0)
     }
 }
 
@@ -272,13 +591,111 @@ fn sinc(u: f64) -> f64 {
     }
 }
 
+/// Coarse points per padded period on which the periodic images of a
+/// kernel are estimated and convolved (see [`StressPlan::images`]).
+const COARSE: usize = 32;
+
+/// The wider lattice's period, in padded periods (its own images weigh
+/// `WIDER⁻³` of the first).
+const WIDER: usize = 4;
+
 /// The stress response of one material on one grid: what every depth
 /// plane and line of it is built from. Build once per (material, grid).
 pub struct StressPlan {
     grid: Grid,
     response: Response,
-    dc: M63,
+    dc: [C; 18],
     fft: Fft2,
+    coarse: Coarse,
+}
+
+/// The coarse grid over the window on which the periodic images are
+/// subtracted in real space (a DC-FFT of its own, see
+/// [`StressPlan::images`]): `nc` nodes per axis spaced `T/COARSE` (`T`
+/// the padded period, so `2n/COARSE` cells), the middle one on the
+/// window's centre (a grid symmetric about it keeps the symmetries of the
+/// load: off centre, the resultant of σyz under a load along x was 8e-9 of
+/// it instead of 0), and each cell's 4-point Lagrange weights on them (the
+/// same along x and y: both periods are `2n` cells).
+struct Coarse {
+    nc: usize,
+    fft: Fft2,
+    /// Per cell index: its first node and the four weights.
+    weights: Vec<(usize, [f64; 4])>,
+}
+
+/// 4-point Lagrange weights at the fraction `f` (nodes −1, 0, 1, 2).
+fn lagrange4(f: f64) -> [f64; 4] {
+    [
+        -f * (f - 1.0) * (f - 2.0) / 6.0,
+        (f + 1.0) * (f - 1.0) * (f - 2.0) / 2.0,
+        -(f + 1.0) * f * (f - 2.0) / 2.0,
+        (f + 1.0) * f * (f - 1.0) / 6.0,
+    ]
+}
+
+impl Coarse {
+    fn new(n: usize) -> Self {
+        // Cells reach COARSE/4 nodes either side of the centre, a stencil
+        // two more.
+        let nc = COARSE / 2 + 5;
+        let cells_per_node = (2 * n) as f64 / COARSE as f64;
+        let centre = 0.5 * (n as f64 - 1.0);
+        let weights = (0..n)
+            .map(|i| {
+                let u = (i as f64 - centre) / cells_per_node + 0.5 * (nc - 1) as f64;
+                let i0 = u.floor();
+                (i0 as usize, lagrange4(u - i0))
+            })
+            .collect();
+        Coarse {
+            nc,
+            fft: Fft2::new(nc),
+            weights,
+        }
+    }
+
+    /// The transpose of the interpolation: each cell's value spread onto
+    /// its 4 x 4 nodes (`Σ E(x − x') f(x') = Σ E(x − X) F(X)` when `E` is
+    /// cubic over a stencil), `nc x nc` row major.
+    fn spread(&self, f: &[f64]) -> Vec<f64> {
+        let (n, nc) = (self.weights.len(), self.nc);
+        let mut rows = vec![0.0; n * nc];
+        for iy in 0..n {
+            let row = &mut rows[iy * nc..(iy + 1) * nc];
+            for (ix, &(first, w)) in self.weights.iter().enumerate() {
+                let v = f[iy * n + ix];
+                if v != 0.0 {
+                    for (b, wb) in w.iter().enumerate() {
+                        row[first + b] += wb * v;
+                    }
+                }
+            }
+        }
+        let mut out = vec![0.0; nc * nc];
+        for (iy, &(first, w)) in self.weights.iter().enumerate() {
+            for (a, wa) in w.iter().enumerate() {
+                let dst = &mut out[(first + a) * nc..(first + a + 1) * nc];
+                for (d, r) in dst.iter_mut().zip(&rows[iy * nc..(iy + 1) * nc]) {
+                    *d += wa * r;
+                }
+            }
+        }
+        out
+    }
+
+    /// `g` (`nc x nc` nodes) interpolated at cell `(ix, iy)`.
+    fn at(&self, g: &[f64], ix: usize, iy: usize) -> f64 {
+        let nc = self.nc;
+        let (fx, wx) = self.weights[ix];
+        let (fy, wy) = self.weights[iy];
+        let mut acc = 0.0;
+        for (a, wa) in wy.iter().enumerate() {
+            let row = &g[(fy + a) * nc + fx..(fy + a) * nc + fx + 4];
+            acc += wa * (wx[0] * row[0] + wx[1] * row[1] + wx[2] * row[2] + wx[3] * row[3]);
+        }
+        acc
+    }
 }
 
 /// The spectra of a state's tractions on the padded grid (three forward
@@ -286,22 +703,32 @@ pub struct StressPlan {
 pub struct TractionSpectra {
     /// `q̂x, q̂y, p̂`, natural order, `[kx][ky]` (see [`crate::operators::fft2`]).
     spectra: [Vec<C>; 3],
+    /// The same on the coarse grid of the images ([`Coarse::spread`]).
+    coarse: [Vec<C>; 3],
     /// `qx, qy, p` themselves (the stresses on the surface plane).
     fields: [Vec<f64>; 3],
 }
 
 /// The kernel spectra of one depth plane (18 half spectra of the padded
-/// grid: `6 x 3` stress components per traction component), applied to
-/// many states. `18 · 16 · 2n(n + 1)` bytes: 151 MB at `n = 512`.
+/// grid: `6 x 3` stress components per traction component) and of its
+/// periodic images on the coarse grid, applied to many states.
+/// `18 · 16 · 2n(n + 1)` bytes: 151 MB at `n = 512`.
 pub struct StressPlane {
     depth_m: f64,
     kernel: Vec<[C; 18]>,
+    /// The images `E` on the coarse grid's padded spectrum.
+    images: Vec<[C; 18]>,
 }
 
 impl StressPlane {
     /// The depth of the plane, m.
     pub fn depth_m(&self) -> f64 {
         self.depth_m
+    }
+
+    /// Bytes of its spectra.
+    pub fn bytes(&self) -> usize {
+        (self.kernel.len() + self.images.len()) * std::mem::size_of::<[C; 18]>()
     }
 }
 
@@ -356,6 +783,7 @@ impl StressPlan {
             response,
             dc,
             fft: Fft2::new(grid.n),
+            coarse: Coarse::new(grid.n),
         })
     }
 
@@ -370,7 +798,7 @@ impl StressPlan {
     /// (m). For tests and documentation of the response itself.
     pub fn response(&self, ex: f64, ey: f64, z: f64) -> [[C; 3]; 6] {
         let m = self.response.at(ex, ey, z);
-        std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+        std::array::from_fn(|i| std::array::from_fn(|j| m[3 * i + j]))
     }
 
     /// The alias orders summed at depth `z`.
@@ -387,7 +815,7 @@ impl StressPlan {
 
     /// The discrete kernel spectrum (18 values) at padded-grid frequency
     /// `(kx, ky)`: the response times the cell's transform, summed over aliases.
-    fn kernel_at(&self, kx: usize, ky: usize, z: f64, aliases: i64) -> M63 {
+    fn kernel_at(&self, kx: usize, ky: usize, z: f64, aliases: i64) -> [C; 18] {
         let m = 2 * self.grid.n;
         if kx == 0 && ky == 0 {
             return self.dc;
@@ -414,14 +842,21 @@ impl StressPlan {
                 1.0
             }
         };
-        let mut acc = M63::zeros();
+        let mut acc = [C::default(); 18];
+        // (the y factors once, not per x order: 81 sines a frequency at the surface)
+        let mut along_y = [(0.0, 0.0); 2 * MAX_ALIASES as usize + 1];
+        for (jy, v) in (-aliases..=aliases).zip(along_y.iter_mut()) {
+            let ey = ey0 + tau * jy as f64 / dy;
+            *v = (ey, sinc(0.5 * ey * dy) * end(jy));
+        }
         for jx in -aliases..=aliases {
             let ex = ex0 + tau * jx as f64 / dx;
             let bx = sinc(0.5 * ex * dx) * end(jx);
-            for jy in -aliases..=aliases {
-                let ey = ey0 + tau * jy as f64 / dy;
-                let b = bx * sinc(0.5 * ey * dy) * end(jy);
-                acc += self.response.at(ex, ey, z) * C::new(b, 0.0);
+            for &(ey, by) in &along_y[..(2 * aliases + 1) as usize] {
+                let b = bx * by;
+                for (a, v) in acc.iter_mut().zip(self.response.at(ex, ey, z)) {
+                    *a += v * b;
+                }
             }
         }
         acc
@@ -442,36 +877,16 @@ impl StressPlan {
             let this = &*self;
             kernel.par_chunks_mut(m).enumerate().for_each(|(kx, col)| {
                 for (ky, v) in col.iter_mut().enumerate() {
-                    let k = this.kernel_at(kx, ky, depth_m, aliases);
-                    *v = std::array::from_fn(|c| k[(c / 3, c % 3)]);
+                    *v = this.kernel_at(kx, ky, depth_m, aliases);
                 }
             });
         }
-        let images = self.images(depth_m);
-        let mut real = vec![0.0; m * m];
-        let mut spec = vec![C::default(); self.fft.spectrum_len()];
-        for c in 0..18 {
-            for iy in 0..m {
-                let y = if iy < n {
-                    iy as f64
-                } else {
-                    iy as f64 - m as f64
-                } * self.grid.dy;
-                for ix in 0..m {
-                    let x = if ix < n {
-                        ix as f64
-                    } else {
-                        ix as f64 - m as f64
-                    } * self.grid.dx;
-                    real[iy * m + ix] = images.at(c, x, y);
-                }
-            }
-            self.fft.forward_full(&real, &mut spec);
-            for (k, s) in kernel.iter_mut().zip(&spec) {
-                k[c] -= s;
-            }
-        }
-        Ok(StressPlane { depth_m, kernel })
+        let image_spectra = self.image_spectra(depth_m);
+        Ok(StressPlane {
+            depth_m,
+            kernel,
+            images: image_spectra,
+        })
     }
 
     /// The periodic images a kernel sampled on the padded grid's
@@ -484,19 +899,17 @@ impl StressPlan {
     /// cancels in the difference), and interpolated. Without it, the
     /// in-plane stresses at depth z carry an offset of order `F z / T³`
     /// (1 % of p0 at z = 1.5a on a domain 4a wide).
-    fn images(&self, z: f64) -> Images {
-        const COARSE: usize = 64;
-        const WIDER: usize = 4;
+    fn images(&self, z: f64, coarse: usize) -> Images {
         let n = self.grid.n;
         let (tx, ty) = (2.0 * n as f64 * self.grid.dx, 2.0 * n as f64 * self.grid.dy);
-        let (cx, cy) = (tx / COARSE as f64, ty / COARSE as f64);
+        let (cx, cy) = (tx / coarse as f64, ty / coarse as f64);
         let rho_c = std::f64::consts::PI / (3.0 * cx.max(cy));
         let (dx, dy) = (self.grid.dx, self.grid.dy);
         let tau = 2.0 * std::f64::consts::PI;
         // The kernel periodised with period `periods · T`, smoothed, at the
         // coarse points `m · (cx, cy)`, m in [0, side)².
         let periodic = |periods: usize| -> Vec<[f64; 18]> {
-            let side = COARSE * periods;
+            let side = coarse * periods;
             let signed = |k: usize| {
                 if k > side / 2 {
                     k as f64 - side as f64
@@ -504,21 +917,22 @@ impl StressPlan {
                     k as f64
                 }
             };
+            use rayon::prelude::*;
             let mut spec: Vec<[C; 18]> = (0..side * side)
+                .into_par_iter()
                 .map(|i| {
                     let (ky, kx) = (i / side, i % side);
                     let ex = tau * signed(kx) / (periods as f64 * tx);
                     let ey = tau * signed(ky) / (periods as f64 * ty);
-                    let k = if kx == 0 && ky == 0 {
+                    if kx == 0 && ky == 0 {
                         self.dc
                     } else {
-                        let rho = ex.hypot(ey);
+                        let rho = (ex * ex + ey * ey).sqrt();
                         let b = sinc(0.5 * ex * dx)
                             * sinc(0.5 * ey * dy)
                             * (-(rho / rho_c).powi(2)).exp();
-                        self.response.at(ex, ey, z) * C::new(b, 0.0)
-                    };
-                    std::array::from_fn(|c| k[(c / 3, c % 3)])
+                        self.response.at(ex, ey, z).map(|v| v * b)
+                    }
                 })
                 .collect();
             // f_T(x) = (1/(T_x T_y)) Σ_k f̂(η_k) e^{−iη_k·x}: forward transforms.
@@ -555,25 +969,20 @@ impl StressPlan {
         };
         let near = periodic(1);
         let far = periodic(WIDER);
-        let reach = COARSE as i64 / 2 + 3;
+        let reach = coarse as i64 / 2 + 4;
         let width = 2 * reach as usize + 1;
         let wrap = |m: i64, side: usize| m.rem_euclid(side as i64) as usize;
         let mut values = vec![[0.0; 18]; width * width];
         for my in -reach..=reach {
             for mx in -reach..=reach {
-                let a = near[wrap(my, COARSE) * COARSE + wrap(mx, COARSE)];
-                let side = COARSE * WIDER;
+                let a = near[wrap(my, coarse) * coarse + wrap(mx, coarse)];
+                let side = coarse * WIDER;
                 let b = far[wrap(my, side) * side + wrap(mx, side)];
                 values[(my + reach) as usize * width + (mx + reach) as usize] =
                     std::array::from_fn(|c| a[c] - b[c]);
             }
         }
-        Images {
-            cx,
-            cy,
-            reach,
-            values,
-        }
+        Images { reach, values }
     }
 
     /// The three traction spectra of a state (`p`, `qx`, `qy` row major on
@@ -585,8 +994,16 @@ impl StressPlan {
             self.fft.forward_padded(f, &mut s);
             s
         });
+        let clen = self.coarse.fft.spectrum_len();
+        let coarse = [qx, qy, p].map(|f| {
+            let mut s = vec![C::default(); clen];
+            let nodes = self.coarse.spread(f);
+            self.coarse.fft.forward_padded(&nodes, &mut s);
+            s
+        });
         TractionSpectra {
             spectra,
+            coarse,
             fields: [qx.to_vec(), qy.to_vec(), p.to_vec()],
         }
     }
@@ -607,6 +1024,15 @@ impl StressPlan {
             self.fft.inverse_cropped(&mut spec, &mut out);
             out
         });
+        let images = self.image_stresses(plane, t);
+        let mut components: [Vec<f64>; 6] = components;
+        for (out, g) in components.iter_mut().zip(&images) {
+            for iy in 0..n {
+                for ix in 0..n {
+                    out[iy * n + ix] -= self.coarse.at(g, ix, iy);
+                }
+            }
+        }
         let mut field = StressField {
             depth_m: plane.depth_m,
             components,
@@ -615,6 +1041,25 @@ impl StressPlan {
             surface_tractions_exact(&mut field, t, self);
         }
         field
+    }
+
+    /// The stresses of the periodic images on the coarse nodes
+    /// (`Σ E(X − X') T(X')`, six `nc x nc` fields), to be interpolated and
+    /// subtracted: 18 products and 6 inverse transforms of the coarse grid.
+    fn image_stresses(&mut self, plane: &StressPlane, t: &TractionSpectra) -> [Vec<f64>; 6] {
+        let nc = self.coarse.nc;
+        let mut spec = vec![C::default(); self.coarse.fft.spectrum_len()];
+        std::array::from_fn(|c| {
+            for (i, s) in spec.iter_mut().enumerate() {
+                let k = &plane.images[i];
+                *s = k[3 * c] * t.coarse[0][i]
+                    + k[3 * c + 1] * t.coarse[1][i]
+                    + k[3 * c + 2] * t.coarse[2][i];
+            }
+            let mut out = vec![0.0; nc * nc];
+            self.coarse.fft.inverse_cropped(&mut spec, &mut out);
+            out
+        })
     }
 
     /// The stress along one line of `plane` under `t`: the products and a
@@ -644,9 +1089,13 @@ impl StressPlan {
         let mut sums = vec![[C::default(); 6]; m];
         match line {
             Line::Row(iy) => {
+                // (the phases of a row once, not per frequency)
+                let phases: Vec<C> = (0..m)
+                    .map(|ky| C::from_polar(1.0, tau * (ky * iy % m) as f64 / m as f64))
+                    .collect();
                 for (kx, g) in sums.iter_mut().enumerate().take(h) {
-                    for ky in 0..m {
-                        let ph = C::from_polar(weight(kx), tau * (ky * iy % m) as f64 / m as f64);
+                    for (ky, ph) in phases.iter().enumerate() {
+                        let ph = ph * weight(kx);
                         for (a, v) in g.iter_mut().zip(product(kx * m + ky)) {
                             *a += v * ph;
                         }
@@ -665,10 +1114,22 @@ impl StressPlan {
             }
         }
         let fft = FftPlanner::<f64>::new().plan_fft_inverse(m);
+        let images = self.image_stresses(plane, t);
+        let coarse = &self.coarse;
         let components = std::array::from_fn(|c| {
             let mut buf: Vec<C> = sums.iter().map(|g| g[c]).collect();
             fft.process(&mut buf);
-            buf[..n].iter().map(|v| v.re / (m * m) as f64).collect()
+            buf[..n]
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let e = match line {
+                        Line::Row(iy) => coarse.at(&images[c], i, iy),
+                        Line::Column(ix) => coarse.at(&images[c], ix, i),
+                    };
+                    v.re / (m * m) as f64 - e
+                })
+                .collect()
         });
         let mut field = StressField {
             depth_m: plane.depth_m,
@@ -690,50 +1151,473 @@ impl StressPlan {
         field
     }
 
+    /// True when the plane at `depth_m` sums aliases (within
+    /// `ALIAS_FREE_DEPTH_CELLS` of the surface): [`StressPlan::slice`]
+    /// takes only deeper rows.
+    pub fn sums_aliases(&self, depth_m: f64) -> bool {
+        self.aliases(depth_m) > 0
+    }
+
+    /// The coarse spectra of the periodic images at depth `z`
+    /// ([`StressPlan::images`]) for the real-space correction.
+    fn image_spectra(&mut self, z: f64) -> Vec<[C; 18]> {
+        let images = self.images(z, COARSE);
+        // E at the coarse offsets m in [−nc, nc), periodic on the coarse
+        // padded grid, and its 18 spectra.
+        let nc = self.coarse.nc;
+        let side = 2 * nc;
+        let mut real = vec![0.0; side * side];
+        let mut spec = vec![C::default(); self.coarse.fft.spectrum_len()];
+        let mut out = vec![[C::default(); 18]; spec.len()];
+        let signed = |i: usize| {
+            if i < nc {
+                i as i64
+            } else {
+                i as i64 - side as i64
+            }
+        };
+        for c in 0..18 {
+            for iy in 0..side {
+                for ix in 0..side {
+                    // (offset −nc joins no two nodes: left 0)
+                    let (mx, my) = (signed(ix), signed(iy));
+                    real[iy * side + ix] = if mx.abs() < nc as i64 && my.abs() < nc as i64 {
+                        images.at_node(c, mx, my)
+                    } else {
+                        0.0
+                    };
+                }
+            }
+            self.coarse.fft.forward_full(&real, &mut spec);
+            for (k, v) in out.iter_mut().zip(&spec) {
+                k[c] = *v;
+            }
+        }
+        out
+    }
+
+    /// The rows of slices at depths `depths_m` (each deeper than the
+    /// aliases reach, [`StressPlan::sums_aliases`]) along `lines`, for every
+    /// state of `states`: `[state][line][depth]`. No plane is built: each
+    /// frequency's response is evaluated once for all depths (for an
+    /// isotropic body `e^{−s}(A − isB)` with `A`, `B` shared by the depths)
+    /// and its products with the tractions summed straight into the
+    /// lines' partial transforms; the periodic images are subtracted as
+    /// for a plane. The same numbers as [`StressPlan::plane`] and
+    /// [`StressPlan::apply_line`] to round-off.
+    pub fn slice(
+        &mut self,
+        depths_m: &[f64],
+        states: &[TractionSpectra],
+        lines: &[Line],
+    ) -> Result<Vec<Vec<Vec<StressField>>>, SolverError> {
+        for &z in depths_m {
+            check_depth(z)?;
+            if self.sums_aliases(z) {
+                return Err(SolverError::invalid(
+                    "depth",
+                    format!("a slice row at {z} m sums aliases: build its plane instead"),
+                ));
+            }
+        }
+        let n = self.grid.n;
+        let m = 2 * n;
+        let h = m / 2 + 1;
+        let (rows, ns, nl) = (depths_m.len(), states.len(), lines.len());
+        let tau = std::f64::consts::TAU;
+        let (dx, dy) = (self.grid.dx, self.grid.dy);
+        let signed = |k: usize| {
+            if k > m / 2 {
+                k as f64 - m as f64
+            } else {
+                k as f64
+            }
+        };
+        let weight = |kx: usize| if kx == 0 || kx == m / 2 { 1.0 } else { 2.0 };
+        // Per line: the phase of each frequency along the other axis.
+        let phases: Vec<Vec<C>> = lines
+            .iter()
+            .map(|line| {
+                let at = match *line {
+                    Line::Row(iy) => iy,
+                    Line::Column(ix) => ix,
+                };
+                (0..m)
+                    .map(|k| C::from_polar(1.0, tau * (k * at % m) as f64 / m as f64))
+                    .collect()
+            })
+            .collect();
+        // Partial transforms `[state][line][row][k][component]`, k the
+        // frequency along the line; chunks of kx in a fixed number (the
+        // sums do not depend on the threads) summed in order.
+        const CHUNKS: usize = 8;
+        let size = h.div_ceil(CHUNKS);
+        let at = |s: usize, l: usize, r: usize, k: usize| ((s * nl + l) * rows + r) * m + k;
+        let this = &*self;
+        let iso = self.response.isotropic;
+        // Evenly spaced depths (a slice's): each root's exponential steps
+        // from one depth to the next by one product instead of an
+        // exponential (three a node and depth: most of a crystal's slice).
+        let step = match depths_m {
+            [first, second, ..] => {
+                let dz = second - first;
+                let even = depths_m.iter().enumerate().all(|(r, &z)| {
+                    (z - (first + r as f64 * dz)).abs() <= 1e-12 * depths_m[rows - 1]
+                });
+                even.then_some(dz)
+            }
+            _ => None,
+        };
+        let partial = |chunk: usize| -> Vec<[C; 6]> {
+            let mut sums = vec![[C::default(); 6]; ns * nl * rows * m];
+            // Per state, node and matrix `Q_k`: `Q_k t̂` (6 values), formed
+            // once per frequency and combined per depth with Putzer's
+            // coefficients (for an isotropic body the nodes summed first).
+            let mut qt = vec![[[[C::default(); 6]; 3]; 4]; ns];
+            let mut prods = vec![[C::default(); 6]; ns];
+            for kx in chunk * size..((chunk + 1) * size).min(h) {
+                let ex = -tau * signed(kx) / (m as f64 * dx);
+                let bx = sinc(0.5 * ex * dx);
+                for ky in 0..m {
+                    let i = kx * m + ky;
+                    let tr =
+                        |t: &TractionSpectra| [t.spectra[0][i], t.spectra[1][i], t.spectra[2][i]];
+                    let mut add = |r: usize, prods: &[[C; 6]]| {
+                        for (s, prod) in prods.iter().enumerate() {
+                            for (l, line) in lines.iter().enumerate() {
+                                let (slot, ph) = match line {
+                                    Line::Row(_) => (kx, phases[l][ky] * weight(kx)),
+                                    Line::Column(_) => (ky, phases[l][kx] * weight(kx)),
+                                };
+                                let acc = &mut sums[at(s, l, r, slot)];
+                                for (a, v) in acc.iter_mut().zip(prod) {
+                                    *a += v * ph;
+                                }
+                            }
+                        }
+                    };
+                    if kx == 0 && ky == 0 {
+                        for (p, t) in prods.iter_mut().zip(states) {
+                            let t = tr(t);
+                            *p = std::array::from_fn(|c| {
+                                (0..3).map(|j| this.dc[3 * c + j] * t[j]).sum()
+                            });
+                        }
+                        for r in 0..rows {
+                            add(r, &prods);
+                        }
+                        continue;
+                    }
+                    let ey = -tau * signed(ky) / (m as f64 * dy);
+                    let b = bx * sinc(0.5 * ey * dy);
+                    let rho = (ex * ex + ey * ey).sqrt();
+                    let nodes = this.response.nodes(ey.atan2(ex));
+                    // A crystal's smooth stencil: one interpolated node.
+                    let interp = if iso {
+                        None
+                    } else {
+                        this.response.interpolated(&nodes)
+                    };
+                    let (count, refs, wts): (usize, [&Node; 4], [f64; 4]) = match &interp {
+                        Some(node) => (1, [node; 4], [1.0, 0.0, 0.0, 0.0]),
+                        None => (
+                            4,
+                            nodes.map(|(i, _)| &this.response.nodes[i]),
+                            nodes.map(|(_, w)| w),
+                        ),
+                    };
+                    let kinds = if iso { 2 } else { 3 };
+                    for (q, t) in qt.iter_mut().zip(states) {
+                        let t = tr(t);
+                        for j in 0..count {
+                            let (node, w) = (refs[j], wts[j]);
+                            for (qk, mk) in q[j].iter_mut().zip(&node.q).take(kinds) {
+                                *qk = std::array::from_fn(|c| {
+                                    (mk[3 * c] * t[0] + mk[3 * c + 1] * t[1] + mk[3 * c + 2] * t[2])
+                                        * (w * b)
+                                });
+                            }
+                        }
+                    }
+                    if iso {
+                        // One set of coefficients for the four nodes: sum them now.
+                        for q in qt.iter_mut() {
+                            let (first, rest) = q.split_at_mut(1);
+                            for other in rest.iter() {
+                                for (a, b) in first[0].iter_mut().zip(other).take(2) {
+                                    for (x, y) in a.iter_mut().zip(b) {
+                                        *x += y;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    let mut exps = [[C::default(); 3]; 4];
+                    let mut steps = [[C::default(); 3]; 4];
+                    if let (Some(dz), false) = (step, iso) {
+                        let (x0, dx1) = (C::new(0.0, -rho * depths_m[0]), C::new(0.0, -rho * dz));
+                        for j in 0..count {
+                            let lam = &refs[j].lam;
+                            exps[j] = lam.map(|l| (x0 * l).exp());
+                            steps[j] = lam.map(|l| (dx1 * l).exp());
+                        }
+                    }
+                    for (r, &z) in depths_m.iter().enumerate() {
+                        let s = rho * z;
+                        let mut gs = [[C::default(); 3]; 4];
+                        if !iso {
+                            for j in 0..count {
+                                if r > 0 && step.is_some() {
+                                    for (a, b) in exps[j].iter_mut().zip(&steps[j]) {
+                                        *a *= b;
+                                    }
+                                }
+                                gs[j] = match step {
+                                    Some(_) => divided_with(s, refs[j], &exps[j]),
+                                    None => divided(s, refs[j]),
+                                };
+                            }
+                        }
+                        for (p, q) in prods.iter_mut().zip(&qt) {
+                            *p = [C::default(); 6];
+                            if iso {
+                                // e^{−s} (A − isB) t̂
+                                let (g0, g1) = ((-s).exp(), -s * (-s).exp());
+                                for (c, v) in p.iter_mut().enumerate() {
+                                    let (a0, a1) = (q[0][0][c], q[0][1][c]);
+                                    *v = C::new(a0.re * g0 - a1.im * g1, a0.im * g0 + a1.re * g1);
+                                }
+                            } else {
+                                for (j, g) in gs.iter().enumerate().take(count) {
+                                    for (c, v) in p.iter_mut().enumerate() {
+                                        *v += g[0] * q[j][0][c]
+                                            + g[1] * q[j][1][c]
+                                            + g[2] * q[j][2][c];
+                                    }
+                                }
+                            }
+                        }
+                        add(r, &prods);
+                    }
+                }
+            }
+            sums
+        };
+        let parts: Vec<Vec<[C; 6]>> = {
+            use rayon::prelude::*;
+            (0..CHUNKS).into_par_iter().map(partial).collect()
+        };
+        let mut sums = vec![[C::default(); 6]; ns * nl * rows * m];
+        for part in &parts {
+            for (a, p) in sums.iter_mut().zip(part) {
+                for (x, y) in a.iter_mut().zip(p) {
+                    *x += y;
+                }
+            }
+        }
+        drop(parts);
+        let fft = FftPlanner::<f64>::new().plan_fft_inverse(m);
+        let mut out: Vec<Vec<Vec<StressField>>> = (0..ns)
+            .map(|_| (0..nl).map(|_| Vec::with_capacity(rows)).collect())
+            .collect();
+        // The images vary slowly in z too (the nearest is T/2 away, T the
+        // padded period): for many rows they are computed at anchor depths
+        // T/32 apart and interpolated (4-point Lagrange in z; T/16 apart
+        // left 2.1e-6 p0 on a Hertz slice, 64², against each row's own);
+        // their own lattice sums cost more than a row's products otherwise.
+        let (lo, hi) = depths_m
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &z| (a.min(z), b.max(z)));
+        let period = (m as f64 * dx).max(m as f64 * dy);
+        let anchors = (((hi - lo) / (period / 32.0)).ceil() as usize + 1).max(4);
+        let anchored: Option<Anchors> = (anchors < rows).then(|| {
+            let zs: Vec<f64> = (0..anchors)
+                .map(|k| lo + (hi - lo) * k as f64 / (anchors - 1) as f64)
+                .collect();
+            let spectra = zs.iter().map(|&z| self.image_spectra(z)).collect();
+            (zs, spectra)
+        });
+        for (r, &z) in depths_m.iter().enumerate() {
+            let images = StressPlane {
+                depth_m: z,
+                kernel: Vec::new(),
+                images: match &anchored {
+                    None => self.image_spectra(z),
+                    Some((zs, spectra)) => {
+                        let u = (z - zs[0]) / (zs[1] - zs[0]);
+                        let first = (u.floor() as i64 - 1).clamp(0, anchors as i64 - 4) as usize;
+                        // Lagrange weights on anchors first..first + 4.
+                        let w: [f64; 4] = std::array::from_fn(|j| {
+                            (0..4)
+                                .filter(|&k| k != j)
+                                .map(|k| (u - (first + k) as f64) / (j as f64 - k as f64))
+                                .product()
+                        });
+                        let mut out = vec![[C::default(); 18]; spectra[0].len()];
+                        for (j, wj) in w.iter().enumerate() {
+                            for (o, v) in out.iter_mut().zip(&spectra[first + j]) {
+                                for (a, b) in o.iter_mut().zip(v) {
+                                    *a += b * wj;
+                                }
+                            }
+                        }
+                        out
+                    }
+                },
+            };
+            for (s, t) in states.iter().enumerate() {
+                let e = self.image_stresses(&images, t);
+                for (l, line) in lines.iter().enumerate() {
+                    let coarse = &self.coarse;
+                    let components = std::array::from_fn(|c| {
+                        let mut buf: Vec<C> = (0..m).map(|k| sums[at(s, l, r, k)][c]).collect();
+                        fft.process(&mut buf);
+                        buf[..n]
+                            .iter()
+                            .enumerate()
+                            .map(|(i, v)| {
+                                let img = match *line {
+                                    Line::Row(iy) => coarse.at(&e[c], i, iy),
+                                    Line::Column(ix) => coarse.at(&e[c], ix, i),
+                                };
+                                v.re / (m * m) as f64 - img
+                            })
+                            .collect()
+                    });
+                    out[s][l].push(StressField {
+                        depth_m: z,
+                        components,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// `qx, qy, p` of a state.
     fn traction_fields(&self, t: &TractionSpectra) -> [Vec<f64>; 3] {
         t.fields.clone()
     }
 }
 
+/// The plane as it was built before issue #51, the tests' oracle: every
+/// frequency through `P`, `W`, `H` interpolated and the matrix exponential,
+/// and the images interpolated to every cell of the padded grid and
+/// subtracted from the kernel (18 more transforms of the padded grid).
+#[cfg(test)]
+impl StressPlan {
+    fn reference_plane(&mut self, depth_m: f64) -> StressPlane {
+        let n = self.grid.n;
+        let m = 2 * n;
+        let h = m / 2 + 1;
+        let aliases = self.aliases(depth_m);
+        let tau = std::f64::consts::TAU;
+        let (dx, dy) = (self.grid.dx, self.grid.dy);
+        let signed = |k: usize| {
+            if k > m / 2 {
+                k as f64 - m as f64
+            } else {
+                k as f64
+            }
+        };
+        let end = |j: i64| {
+            if aliases > 0 && j.abs() == aliases {
+                0.5
+            } else {
+                1.0
+            }
+        };
+        let mut kernel = vec![[C::default(); 18]; h * m];
+        for kx in 0..h {
+            for ky in 0..m {
+                if kx == 0 && ky == 0 {
+                    kernel[0] = self.dc;
+                    continue;
+                }
+                let ex0 = -tau * signed(kx) / (m as f64 * dx);
+                let ey0 = -tau * signed(ky) / (m as f64 * dy);
+                let mut acc = M63::zeros();
+                for jx in -aliases..=aliases {
+                    let ex = ex0 + tau * jx as f64 / dx;
+                    let bx = sinc(0.5 * ex * dx) * end(jx);
+                    for jy in -aliases..=aliases {
+                        let ey = ey0 + tau * jy as f64 / dy;
+                        let b = bx * sinc(0.5 * ey * dy) * end(jy);
+                        acc += self.response.reference_at(ex, ey, depth_m) * C::new(b, 0.0);
+                    }
+                }
+                kernel[kx * m + ky] = flat(&acc);
+            }
+        }
+        const OLD_COARSE: usize = 64;
+        let images = self.images(depth_m, OLD_COARSE);
+        let (cx, cy) = (
+            m as f64 * dx / OLD_COARSE as f64,
+            m as f64 * dy / OLD_COARSE as f64,
+        );
+        let width = 2 * images.reach as usize + 1;
+        let at = |c: usize, x: f64, y: f64| -> f64 {
+            let (ux, uy) = (x / cx, y / cy);
+            let (ix, iy) = (ux.floor(), uy.floor());
+            let (wx, wy) = (lagrange4(ux - ix), lagrange4(uy - iy));
+            let mut acc = 0.0;
+            for (j, wyj) in wy.iter().enumerate() {
+                let row = (iy as i64 - 1 + j as i64 + images.reach) as usize * width;
+                for (i, wxi) in wx.iter().enumerate() {
+                    let col = (ix as i64 - 1 + i as i64 + images.reach) as usize;
+                    acc += wyj * wxi * images.values[row + col][c];
+                }
+            }
+            acc
+        };
+        let mut real = vec![0.0; m * m];
+        let mut spec = vec![C::default(); self.fft.spectrum_len()];
+        for c in 0..18 {
+            for iy in 0..m {
+                let y = if iy < n {
+                    iy as f64
+                } else {
+                    iy as f64 - m as f64
+                } * dy;
+                for ix in 0..m {
+                    let x = if ix < n {
+                        ix as f64
+                    } else {
+                        ix as f64 - m as f64
+                    } * dx;
+                    real[iy * m + ix] = at(c, x, y);
+                }
+            }
+            self.fft.forward_full(&real, &mut spec);
+            for (k, s) in kernel.iter_mut().zip(&spec) {
+                k[c] -= s;
+            }
+        }
+        StressPlane {
+            depth_m,
+            kernel,
+            images: vec![[C::default(); 18]; self.coarse.fft.spectrum_len()],
+        }
+    }
+}
+
+/// Depths and the coarse image spectra at them, interpolated in depth for
+/// a slice's rows ([`StressPlan::slice`]).
+type Anchors = (Vec<f64>, Vec<Vec<[C; 18]>>);
+
 /// The periodic images of a plane's kernel on coarse points, per component
 /// (see [`StressPlan::images`]).
 struct Images {
-    cx: f64,
-    cy: f64,
     reach: i64,
     /// `[my][mx]` for `m` in `[−reach, reach]`.
     values: Vec<[f64; 18]>,
 }
 
 impl Images {
-    /// Component `c` at `(x, y)` (|x|, |y| ≤ T/2), 4-point Lagrange in each direction.
-    fn at(&self, c: usize, x: f64, y: f64) -> f64 {
+    /// Component `c` at the coarse offset `(mx, my)` (within `reach`).
+    fn at_node(&self, c: usize, mx: i64, my: i64) -> f64 {
         let width = 2 * self.reach as usize + 1;
-        let weights = |u: f64| -> (i64, [f64; 4]) {
-            let i0 = u.floor();
-            let f = u - i0;
-            (
-                i0 as i64,
-                [
-                    -f * (f - 1.0) * (f - 2.0) / 6.0,
-                    (f + 1.0) * (f - 1.0) * (f - 2.0) / 2.0,
-                    -(f + 1.0) * f * (f - 2.0) / 2.0,
-                    (f + 1.0) * f * (f - 1.0) / 6.0,
-                ],
-            )
-        };
-        let (ix, wx) = weights(x / self.cx);
-        let (iy, wy) = weights(y / self.cy);
-        let mut acc = 0.0;
-        for (j, wyj) in wy.iter().enumerate() {
-            let row = (iy - 1 + j as i64 + self.reach) as usize * width;
-            for (i, wxi) in wx.iter().enumerate() {
-                let col = (ix - 1 + i as i64 + self.reach) as usize;
-                acc += wyj * wxi * self.values[row + col][c];
-            }
-        }
-        acc
+        self.values[(my + self.reach) as usize * width + (mx + self.reach) as usize][c]
     }
 }
 
@@ -870,7 +1754,7 @@ mod tests {
                 let rel = |a: M63, b: M63| (a - b).camax() / b.camax();
                 worst = worst
                     .max(rel(d.p, exact.p))
-                    .max(rel(r.surface(th), exact.ph));
+                    .max(rel(M63::from_row_slice(&r.surface(th)), exact.ph));
                 worst = worst.max((d.w - exact.w).camax() / exact.w.camax());
                 worst = worst.max((d.h - exact.h).camax() / exact.h.camax());
             }
@@ -887,6 +1771,229 @@ mod tests {
             for p in d.w.eigenvalues().expect("eigenvalues").iter() {
                 assert!(p.im < -0.1, "root {p} does not decay");
             }
+        }
+    }
+
+    /// Putzer's form at a node against `P expm(−isW) H` (the matrix
+    /// exponential by scaling and squaring), from the surface to where the
+    /// response has decayed, for an isotropic body and two crystals.
+    #[test]
+    fn putzer_nodes_equal_the_matrix_exponential() {
+        for name in ["Fe", "Cu(111)", "Fe(111)", "Cu"] {
+            let mat = crate::model::presets::material(name).unwrap();
+            let r = Response::of(&mat).unwrap();
+            let mut worst: f64 = 0.0;
+            for k in (0..STROH_DIRECTIONS).step_by(97) {
+                let (d, node) = (&r.table[k], &r.nodes[k]);
+                let scale = d.ph.camax();
+                for s in [1e-6, 0.01, 0.3, 1.0, 2.7, 8.0, 30.0] {
+                    let want = d.p * expm3(&(d.w * C::new(0.0, -s))) * d.h;
+                    let g = divided(s, node);
+                    let got: [C; 18] = std::array::from_fn(|c| {
+                        node.q[0][c] * g[0] + node.q[1][c] * g[1] + node.q[2][c] * g[2]
+                    });
+                    let err = (0..18)
+                        .map(|c| (got[c] - want[(c / 3, c % 3)]).norm())
+                        .fold(0.0, f64::max);
+                    worst = worst.max(err / scale);
+                }
+            }
+            eprintln!("{name}: Putzer against expm {worst:e} of max |PH|");
+            assert!(worst < 1e-11, "{name}: {worst:e}");
+        }
+    }
+
+    /// The divided differences through a root pair that closes up: the
+    /// series and the difference quotients agree where they meet.
+    #[test]
+    fn divided_differences_are_continuous_across_the_cluster_threshold() {
+        let x = C::new(0.0, -2.0);
+        let base = [C::new(0.1, -1.0), C::new(0.1, -1.0), C::new(-0.3, -0.7)];
+        for gap in [1e-9, 1e-4, 0.2, 0.249, 0.251, 0.3] {
+            let lam = [base[0], base[1] + C::new(gap, 0.0), base[2]];
+            let g = divided(2.0, &Node::with(lam, [[C::default(); 18]; 3]));
+            // Reference: the divided differences by the exponential of the
+            // companion-free bidiagonal matrix (Opitz: exp of the matrix
+            // with λ on the diagonal and ones above carries them).
+            let mut a = M3::zeros();
+            for i in 0..3 {
+                a[(i, i)] = lam[i] * x;
+                if i < 2 {
+                    a[(i, i + 1)] = x;
+                }
+            }
+            let e = expm3(&a);
+            let want = [e[(0, 0)], e[(0, 1)], e[(0, 2)]];
+            for j in 0..3 {
+                assert!(
+                    (g[j] - want[j]).norm() < 1e-13 * want[0].norm().max(1.0),
+                    "gap {gap}, g[{j}] {} against {}",
+                    g[j],
+                    want[j]
+                );
+            }
+        }
+    }
+
+    /// The per-frequency response against the construction before issue
+    /// #51 (P, W, H interpolated, then the exponential): both interpolate
+    /// in θ between the same nodes, so they differ by the interpolation
+    /// error only.
+    #[test]
+    fn fast_response_equals_the_interpolated_matrix_exponential() {
+        // (the crystals twice: their roots interpolated where the stencil
+        // is smooth, and every node's own exponentials everywhere)
+        for (name, interpolate) in [
+            ("Fe", true),
+            ("Fe(111)", true),
+            ("Cu(111)", true),
+            ("Cu(111)", false),
+        ] {
+            let mat = crate::model::presets::material(name).unwrap();
+            let mut r = Response::of(&mat).unwrap();
+            if !interpolate {
+                r.smooth.iter_mut().for_each(|b| *b = false);
+            }
+            let mut worst: f64 = 0.0;
+            for k in 0..200 {
+                let th = 0.37 + k as f64 * 0.0313;
+                let (ex, ey) = (th.cos(), th.sin());
+                let scale = r.reference_at(ex, ey, 0.0).camax();
+                for z in [0.0, 0.02, 0.4, 1.0, 3.5, 12.0] {
+                    let want = r.reference_at(ex, ey, z);
+                    let got = r.at(ex, ey, z);
+                    let err = (0..18)
+                        .map(|c| (got[c] - want[(c / 3, c % 3)]).norm())
+                        .fold(0.0, f64::max);
+                    worst = worst.max(err / scale);
+                }
+            }
+            eprintln!("{name} (roots interpolated: {interpolate}): fast against interpolated expm {worst:e} of max |PH|");
+            assert!(worst < 1e-8, "{name}: {worst:e}");
+        }
+    }
+
+    /// A whole plane against the construction before issue #51 (the
+    /// oracle [`StressPlan::reference_plane`]: matrix exponential per
+    /// frequency, the images interpolated to every cell and subtracted from
+    /// the kernel), under a sliding Hertz field (q = 0.3p, window 4a wide,
+    /// 64²), in units of p0.
+    #[test]
+    fn planes_equal_the_construction_before_issue_51() {
+        let n = 64;
+        let a = 1e-3;
+        let grid = Grid::square(n, 4.0 * a / n as f64);
+        let mut p = vec![0.0; n * n];
+        for iy in 0..n {
+            for ix in 0..n {
+                let r2 = (grid.x(ix).powi(2) + grid.y(iy).powi(2)) / (a * a);
+                p[iy * n + ix] = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
+            }
+        }
+        let qx: Vec<f64> = p.iter().map(|v| 0.3 * v).collect();
+        let qy = vec![0.0; n * n];
+        for name in ["Fe", "Fe(111)"] {
+            let mat = crate::model::presets::material(name).unwrap();
+            let mut plan = StressPlan::new(&mat, grid).unwrap();
+            let t = plan.tractions(&p, &qx, &qy);
+            let mut worst: f64 = 0.0;
+            for z in [0.0, 0.05 * a, 0.3 * a, a, 1.5 * a] {
+                let fast = plan.plane(z).unwrap();
+                let slow = plan.reference_plane(z);
+                let (f, s) = (plan.apply(&fast, &t), plan.apply(&slow, &t));
+                let mut err: f64 = 0.0;
+                for c in 0..6 {
+                    for (u, v) in f.components[c].iter().zip(&s.components[c]) {
+                        err = err.max((u - v).abs());
+                    }
+                }
+                let line = plan.apply_line(&fast, &t, Line::Row(n / 2));
+                for c in 0..6 {
+                    for ix in 0..n {
+                        let v = s.components[c][(n / 2) * n + ix];
+                        err = err.max((line.components[c][ix] - v).abs());
+                    }
+                }
+                eprintln!("{name} z = {:.2}a: new against old {err:e} p0", z / a);
+                worst = worst.max(err);
+            }
+            assert!(worst < 1e-4, "{name}: {worst:e} p0");
+        }
+    }
+
+    /// A slice's rows without planes against the plane of each depth and
+    /// its line (`plane` + `apply_line`), for both kinds of body, two
+    /// states and a row and a column, under a sliding Hertz field (64²):
+    /// the same sums in another order.
+    #[test]
+    fn slice_rows_equal_the_lines_of_their_planes() {
+        let n = 64;
+        let a = 1e-3;
+        let grid = Grid::square(n, 4.0 * a / n as f64);
+        let mut p = vec![0.0; n * n];
+        for iy in 0..n {
+            for ix in 0..n {
+                let r2 = (grid.x(ix).powi(2) + grid.y(iy).powi(2)) / (a * a);
+                p[iy * n + ix] = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
+            }
+        }
+        let qx: Vec<f64> = p.iter().map(|v| 0.3 * v).collect();
+        let qy: Vec<f64> = p.iter().map(|v| -0.1 * v).collect();
+        let lines = [Line::Row(n / 2 - 3), Line::Column(n / 2 + 1)];
+        for name in ["Fe", "Fe(111)"] {
+            let mat = crate::model::presets::material(name).unwrap();
+            let mut plan = StressPlan::new(&mat, grid).unwrap();
+            let states = vec![
+                plan.tractions(&p, &qx, &qy),
+                plan.tractions(&p, &p.iter().map(|v| -0.2 * v).collect::<Vec<_>>(), &qy),
+            ];
+            // Evenly spaced (the exponentials stepped) and not.
+            // (33 evenly spaced rows take their images from 8 anchor depths;
+            // 3 rows their own)
+            let even: Vec<f64> = (7..40).map(|k| k as f64 * 0.05 * a).collect();
+            let uneven = vec![0.6 * a, 0.75 * a, 1.3 * a];
+            for (depths, tol) in [(even, 1e-6), (uneven, 1e-12)] {
+                let mut worst: f64 = 0.0;
+                assert!(depths.iter().all(|&z| !plan.sums_aliases(z)));
+                let rows = plan.slice(&depths, &states, &lines).unwrap();
+                for (r, &z) in depths.iter().enumerate() {
+                    let plane = plan.plane(z).unwrap();
+                    for (s, t) in states.iter().enumerate() {
+                        for (l, &line) in lines.iter().enumerate() {
+                            let want = plan.apply_line(&plane, t, line);
+                            let got = &rows[s][l][r];
+                            assert_eq!(got.depth_m, z);
+                            for c in 0..6 {
+                                for (u, v) in got.components[c].iter().zip(&want.components[c]) {
+                                    worst = worst.max((u - v).abs());
+                                }
+                            }
+                        }
+                    }
+                }
+                eprintln!(
+                    "{name}, {} rows: slice against plane lines {worst:e} p0",
+                    depths.len()
+                );
+                assert!(worst < tol, "{name}: {worst:e} p0");
+            }
+        }
+    }
+
+    /// The crystals' stencils whose roots and matrices interpolate (one
+    /// node's exponentials a frequency): nearly all of them, the rest near
+    /// crossings of roots or where their order wraps at 2π.
+    #[test]
+    fn most_crystal_stencils_interpolate_their_roots() {
+        for name in ["Fe(111)", "Cu(111)", "Ni(111)"] {
+            let mat = crate::model::presets::material(name).unwrap();
+            let r = Response::of(&mat).unwrap();
+            let share = r.smooth.iter().filter(|&&b| b).count() as f64 / r.smooth.len() as f64;
+            eprintln!(
+                "{name}: {:.1} % of the stencils interpolate their roots",
+                100.0 * share
+            );
+            assert!(share > 0.9, "{name}: {share}");
         }
     }
 }

@@ -22,8 +22,8 @@
 use nalgebra::Matrix6;
 use serde::{Deserialize, Serialize};
 
-use crate::operators::stress::{max_principal, tresca, von_mises, Line, StressField, StressPlan};
-use crate::{CaseScalars, CaseSpec, Fields, SolverError, TurningState};
+use crate::operators::stress::{principal, von_mises, Line, StressField, StressPlan, StressPlane};
+use crate::{CaseScalars, CaseSpec, Fields, Grid, Material, SolverError, TurningState};
 
 /// How the Crossland parameter is formed from the states computed.
 pub const CROSSLAND_DEFINITION: &str = "Crossland: sqrt(J2,a) + alpha * sigma_H,max at every point computed (planes and slices), J2,a of the deviatoric amplitude taken as half the largest difference between two states' deviators (exact for two states, the extremes of a fretting cycle; with more, the smallest enclosing sphere's radius exceeds it by at most 2/sqrt(3) for three states and sqrt(5/3) for more), sigma_H,max the largest hydrostatic stress over the states; needs at least two states (a load history)";
@@ -294,6 +294,80 @@ fn crossland_at(ts: &[[f64; 6]], alpha: f64) -> f64 {
     amp + alpha * sh
 }
 
+/// What the cases of a sweep share for their stresses, kept by a worker
+/// from one case to the next: the plan of the last material and grid and
+/// its surface plane (for SWT and the slices' top row), which every case
+/// asks for again and which costs most (its kernel sums 81 alias orders
+/// per frequency: 0.9 s at 256² against 0.05 s for a plane 5 cells deep
+/// or more, docs/performance.md). Deeper planes cost about as much as
+/// applying them and are built per case, which keeps a worker's memory to
+/// two kernels. A case of another material or grid replaces the plan. The
+/// plane is the one a case would build itself, to the bit: `solve` and a
+/// sweep agree.
+#[derive(Default)]
+pub struct StressCache {
+    key: Option<(Material, Grid)>,
+    plan: Option<StressPlan>,
+    planes: Vec<StressPlane>,
+    /// Planes taken from the cache instead of built.
+    hits: usize,
+}
+
+impl StressCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Planes reused so far (a plane built is not counted).
+    pub fn hits(&self) -> usize {
+        self.hits
+    }
+
+    /// Bytes of the planes held.
+    pub fn bytes(&self) -> usize {
+        self.planes.iter().map(StressPlane::bytes).sum()
+    }
+
+    /// The plan of `material` on `grid` and the kept planes, made anew
+    /// when either differs from the last case's.
+    fn prepare(
+        &mut self,
+        material: &Material,
+        grid: Grid,
+    ) -> Result<(&mut StressPlan, &mut Vec<StressPlane>), SolverError> {
+        let same = matches!(&self.key, Some((m, g)) if m == material && *g == grid);
+        if !same || self.plan.is_none() {
+            self.planes.clear();
+            self.plan = None;
+            self.key = None;
+            self.plan = Some(StressPlan::new(material, grid)?);
+            self.key = Some((material.clone(), grid));
+        }
+        let plan = self.plan.as_mut().expect("made above");
+        Ok((plan, &mut self.planes))
+    }
+}
+
+/// The index of the kept plane at `depth_m` (the same bits: the surface),
+/// built and kept when missing.
+fn kept_plane(
+    plan: &mut StressPlan,
+    planes: &mut Vec<StressPlane>,
+    hits: &mut usize,
+    depth_m: f64,
+) -> Result<usize, SolverError> {
+    if let Some(i) = planes
+        .iter()
+        .position(|p| p.depth_m().to_bits() == depth_m.to_bits())
+    {
+        *hits += 1;
+        return Ok(i);
+    }
+    planes.push(plan.plane(depth_m)?);
+    Ok(planes.len() - 1)
+}
+
 /// Computes the stresses `req` asks for on the states of a solved case:
 /// the turning points of its load history (or its final state), else the
 /// case's one state; and the scalars.
@@ -303,6 +377,19 @@ pub fn compute(
     scalars: &CaseScalars,
     fields: &Fields,
     turning: &[TurningState],
+) -> Result<CaseStress, SolverError> {
+    compute_with(req, spec, scalars, fields, turning, &mut StressCache::new())
+}
+
+/// [`compute`] with the plan and the fixed-depth planes of `cache` (a
+/// sweep's worker keeps one across its cases); the same numbers to the bit.
+pub fn compute_with(
+    req: &StressRequest,
+    spec: &CaseSpec,
+    scalars: &CaseScalars,
+    fields: &Fields,
+    turning: &[TurningState],
+    cache: &mut StressCache,
 ) -> Result<CaseStress, SolverError> {
     let grid = spec.grid;
     let n = grid.n;
@@ -314,7 +401,8 @@ pub fn compute(
     } else {
         vec![(None, &fields.p[..], &fields.qx[..], &fields.qy[..])]
     };
-    let mut plan = StressPlan::new(&spec.material, grid)?;
+    let mut hits = cache.hits;
+    let (plan, kept) = cache.prepare(&spec.material, grid)?;
     let tractions: Vec<_> = states
         .iter()
         .map(|(_, p, qx, qy)| plan.tractions(p, qx, qy))
@@ -351,27 +439,64 @@ pub fn compute(
         })
         .collect();
     // One kernel per depth, applied to every state.
+    // The slices: the rows deeper than the aliases reach all at once
+    // (`StressPlan::slice`, no plane built), the others from their planes.
+    let deep: Vec<f64> = slice_depths
+        .iter()
+        .copied()
+        .filter(|&z| z != 0.0 && !plan.sums_aliases(z))
+        .collect();
+    let deep_rows = if deep.is_empty() {
+        Vec::new()
+    } else {
+        plan.slice(&deep, &tractions, &[along, across])?
+    };
+    let mut next_deep = 0;
     for &z in &slice_depths {
-        let plane = plan.plane(z)?;
+        if z != 0.0 && !plan.sums_aliases(z) {
+            for (s, rows) in out.iter_mut().zip(&deep_rows) {
+                s.along.push(rows[0][next_deep].clone());
+                s.across.push(rows[1][next_deep].clone());
+            }
+            next_deep += 1;
+            continue;
+        }
+        // The slices' top row is the surface plane's, kept for SWT.
+        let own;
+        let plane = if z == 0.0 {
+            let i = kept_plane(plan, kept, &mut hits, z)?;
+            &kept[i]
+        } else {
+            own = plan.plane(z)?;
+            &own
+        };
         for (s, t) in out.iter_mut().zip(&tractions) {
-            s.along.push(plan.apply_line(&plane, t, along));
-            s.across.push(plan.apply_line(&plane, t, across));
+            s.along.push(plan.apply_line(plane, t, along));
+            s.across.push(plan.apply_line(plane, t, across));
         }
     }
     let depths_m = req.depths_m.clone();
     let mut surface: Option<Vec<StressField>> = None;
     for &z in &depths_m {
-        let plane = plan.plane(z)?;
+        let own;
+        let plane = if z == 0.0 {
+            let i = kept_plane(plan, kept, &mut hits, z)?;
+            &kept[i]
+        } else {
+            own = plan.plane(z)?;
+            &own
+        };
         for (s, t) in out.iter_mut().zip(&tractions) {
-            s.planes.push(plan.apply(&plane, t));
+            s.planes.push(plan.apply(plane, t));
         }
     }
     // The surface plane for SWT: a plane of the request at z = 0, else its own.
     let on_surface = depths_m.iter().position(|&z| z == 0.0);
     if on_surface.is_none() {
-        let plane = plan.plane(0.0)?;
-        surface = Some(tractions.iter().map(|t| plan.apply(&plane, t)).collect());
+        let i = kept_plane(plan, kept, &mut hits, 0.0)?;
+        surface = Some(tractions.iter().map(|t| plan.apply(&kept[i], t)).collect());
     }
+    cache.hits = hits;
     let surface_of = |k: usize| -> &StressField {
         match (&surface, on_surface) {
             (Some(s), _) => &s[k],
@@ -406,10 +531,10 @@ pub fn compute(
         }
         pts
     };
-    let best = |pts: &[([f64; 6], [f64; 3])], f: &dyn Fn([f64; 6]) -> f64| {
+    let best = |pts: &[([f64; 6], [f64; 3])], f: &dyn Fn(usize) -> f64| {
         let mut b = (f64::NEG_INFINITY, [0.0; 3]);
-        for (s, at) in pts {
-            let v = f(*s);
+        for (i, (_, at)) in pts.iter().enumerate() {
+            let v = f(i);
             if v > b.0 {
                 b = (v, *at);
             }
@@ -426,11 +551,18 @@ pub fn compute(
             let pk = crate::operators::stress::peak(&vals).expect("a line has points");
             located(pk.value, at_line(along, pk.index, 0.0))
         });
+        // The principal stresses once a point, for Tresca and σ₁ both (the
+        // same values; twice, the eigenvalues took 7 % of a 256² case with
+        // `[stress]`, perf).
+        let principals: Vec<[f64; 3]> = pts.iter().map(|(t, _)| principal(*t)).collect();
         state_scalars.push(StateScalars {
             step: st.step,
-            max_von_mises: best(&pts, &von_mises),
-            max_tresca: best(&pts, &tresca),
-            max_principal: best(&pts, &max_principal),
+            max_von_mises: best(&pts, &|i| von_mises(pts[i].0)),
+            max_tresca: best(&pts, &|i| {
+                let [a, _, c] = principals[i];
+                0.5 * (a - c)
+            }),
+            max_principal: best(&pts, &|i| principals[i][0]),
             surface_peak_along_force: surface_peak,
         });
     }
