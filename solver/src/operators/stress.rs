@@ -57,6 +57,16 @@ const ALIAS_FREE_DEPTH_CELLS: f64 = 5.0;
 /// surface itself the series is truncated here).
 const MAX_ALIASES: i64 = 4;
 
+/// Frequency index `k` of a length-`m` transform as a signed wave number
+/// (`k − m` above `m/2`).
+fn signed_frequency(k: usize, m: usize) -> f64 {
+    if k > m / 2 {
+        k as f64 - m as f64
+    } else {
+        k as f64
+    }
+}
+
 /// `P`, `W`, `H` of one in-plane direction θ: `σ̂ = P exp(−isW) H t̂`.
 #[derive(Clone, Copy, Debug)]
 struct Direction {
@@ -820,13 +830,7 @@ impl StressPlan {
         if kx == 0 && ky == 0 {
             return self.dc;
         }
-        let signed = |k: usize| {
-            if k > m / 2 {
-                k as f64 - m as f64
-            } else {
-                k as f64
-            }
-        };
+        let signed = |k: usize| signed_frequency(k, m);
         let (dx, dy) = (self.grid.dx, self.grid.dy);
         let tau = 2.0 * std::f64::consts::PI;
         // The DFT `Σ f e^{−2πi k x/M}` is the transform at η = −2πk/(MΔ).
@@ -1226,13 +1230,7 @@ impl StressPlan {
         let (rows, ns, nl) = (depths_m.len(), states.len(), lines.len());
         let tau = std::f64::consts::TAU;
         let (dx, dy) = (self.grid.dx, self.grid.dy);
-        let signed = |k: usize| {
-            if k > m / 2 {
-                k as f64 - m as f64
-            } else {
-                k as f64
-            }
-        };
+        let signed = |k: usize| signed_frequency(k, m);
         let weight = |kx: usize| if kx == 0 || kx == m / 2 { 1.0 } else { 2.0 };
         // Per line: the phase of each frequency along the other axis.
         let phases: Vec<Vec<C>> = lines
@@ -1513,13 +1511,7 @@ impl StressPlan {
         let aliases = self.aliases(depth_m);
         let tau = std::f64::consts::TAU;
         let (dx, dy) = (self.grid.dx, self.grid.dy);
-        let signed = |k: usize| {
-            if k > m / 2 {
-                k as f64 - m as f64
-            } else {
-                k as f64
-            }
-        };
+        let signed = |k: usize| signed_frequency(k, m);
         let end = |j: i64| {
             if aliases > 0 && j.abs() == aliases {
                 0.5
@@ -1792,10 +1784,7 @@ mod tests {
                     let got: [C; 18] = std::array::from_fn(|c| {
                         node.q[0][c] * g[0] + node.q[1][c] * g[1] + node.q[2][c] * g[2]
                     });
-                    let err = (0..18)
-                        .map(|c| (got[c] - want[(c / 3, c % 3)]).norm())
-                        .fold(0.0, f64::max);
-                    worst = worst.max(err / scale);
+                    worst = worst.max(largest_difference(&got, &want) / scale);
                 }
             }
             eprintln!("{name}: Putzer against expm {worst:e} of max |PH|");
@@ -1862,15 +1851,35 @@ mod tests {
                 for z in [0.0, 0.02, 0.4, 1.0, 3.5, 12.0] {
                     let want = r.reference_at(ex, ey, z);
                     let got = r.at(ex, ey, z);
-                    let err = (0..18)
-                        .map(|c| (got[c] - want[(c / 3, c % 3)]).norm())
-                        .fold(0.0, f64::max);
-                    worst = worst.max(err / scale);
+                    worst = worst.max(largest_difference(&got, &want) / scale);
                 }
             }
             eprintln!("{name} (roots interpolated: {interpolate}): fast against interpolated expm {worst:e} of max |PH|");
             assert!(worst < 1e-8, "{name}: {worst:e}");
         }
+    }
+
+    /// max over the 18 entries of `|got − want|` (`got` in the row-major
+    /// order of the 6x3 response).
+    fn largest_difference(got: &[C; 18], want: &M63) -> f64 {
+        (0..18)
+            .map(|c| (got[c] - want[(c / 3, c % 3)]).norm())
+            .fold(0.0, f64::max)
+    }
+
+    /// A Hertz pressure of radius `a` = 1 mm (p0 = 1) on an `n x n` grid
+    /// 4a wide: `(a, grid, p)`.
+    fn hertz_field(n: usize) -> (f64, Grid, Vec<f64>) {
+        let a = 1e-3;
+        let grid = Grid::square(n, 4.0 * a / n as f64);
+        let mut p = vec![0.0; n * n];
+        for iy in 0..n {
+            for ix in 0..n {
+                let r2 = (grid.x(ix).powi(2) + grid.y(iy).powi(2)) / (a * a);
+                p[iy * n + ix] = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
+            }
+        }
+        (a, grid, p)
     }
 
     /// A whole plane against the construction before issue #51 (the
@@ -1881,15 +1890,7 @@ mod tests {
     #[test]
     fn planes_equal_the_construction_before_issue_51() {
         let n = 64;
-        let a = 1e-3;
-        let grid = Grid::square(n, 4.0 * a / n as f64);
-        let mut p = vec![0.0; n * n];
-        for iy in 0..n {
-            for ix in 0..n {
-                let r2 = (grid.x(ix).powi(2) + grid.y(iy).powi(2)) / (a * a);
-                p[iy * n + ix] = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
-            }
-        }
+        let (a, grid, p) = hertz_field(n);
         let qx: Vec<f64> = p.iter().map(|v| 0.3 * v).collect();
         let qy = vec![0.0; n * n];
         for name in ["Fe", "Fe(111)"] {
@@ -1928,15 +1929,7 @@ mod tests {
     #[test]
     fn slice_rows_equal_the_lines_of_their_planes() {
         let n = 64;
-        let a = 1e-3;
-        let grid = Grid::square(n, 4.0 * a / n as f64);
-        let mut p = vec![0.0; n * n];
-        for iy in 0..n {
-            for ix in 0..n {
-                let r2 = (grid.x(ix).powi(2) + grid.y(iy).powi(2)) / (a * a);
-                p[iy * n + ix] = if r2 < 1.0 { (1.0 - r2).sqrt() } else { 0.0 };
-            }
-        }
+        let (a, grid, p) = hertz_field(n);
         let qx: Vec<f64> = p.iter().map(|v| 0.3 * v).collect();
         let qy: Vec<f64> = p.iter().map(|v| -0.1 * v).collect();
         let lines = [Line::Row(n / 2 - 3), Line::Column(n / 2 + 1)];

@@ -368,6 +368,23 @@ fn kept_plane(
     Ok(planes.len() - 1)
 }
 
+/// The plane at depth `z`: at the surface the kept one ([`kept_plane`]),
+/// elsewhere `plan`'s own, built into `own`.
+fn plane_at<'a>(
+    plan: &mut StressPlan,
+    kept: &'a mut Vec<StressPlane>,
+    hits: &mut usize,
+    z: f64,
+    own: &'a mut Option<StressPlane>,
+) -> Result<&'a StressPlane, SolverError> {
+    if z == 0.0 {
+        let i = kept_plane(plan, kept, hits, z)?;
+        Ok(&kept[i])
+    } else {
+        Ok(own.insert(plan.plane(z)?))
+    }
+}
+
 /// Computes the stresses `req` asks for on the states of a solved case:
 /// the turning points of its load history (or its final state), else the
 /// case's one state; and the scalars.
@@ -462,14 +479,8 @@ pub fn compute_with(
             continue;
         }
         // The slices' top row is the surface plane's, kept for SWT.
-        let own;
-        let plane = if z == 0.0 {
-            let i = kept_plane(plan, kept, &mut hits, z)?;
-            &kept[i]
-        } else {
-            own = plan.plane(z)?;
-            &own
-        };
+        let mut own = None;
+        let plane = plane_at(plan, kept, &mut hits, z, &mut own)?;
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.along.push(plan.apply_line(plane, t, along));
             s.across.push(plan.apply_line(plane, t, across));
@@ -478,14 +489,8 @@ pub fn compute_with(
     let depths_m = req.depths_m.clone();
     let mut surface: Option<Vec<StressField>> = None;
     for &z in &depths_m {
-        let own;
-        let plane = if z == 0.0 {
-            let i = kept_plane(plan, kept, &mut hits, z)?;
-            &kept[i]
-        } else {
-            own = plan.plane(z)?;
-            &own
-        };
+        let mut own = None;
+        let plane = plane_at(plan, kept, &mut hits, z, &mut own)?;
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.planes.push(plan.apply(plane, t));
         }
