@@ -313,28 +313,37 @@ fn children(pid: u32) -> Vec<u32> {
 fn killed_worker_is_detected_and_its_case_requeued() {
     let dir = scratch("kill");
     let started = std::time::Instant::now();
-    let coord = sweep_cmd(&dir, "out", 2, "e")
+    let mut coord = sweep_cmd(&dir, "out", 2, "e")
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     let o = dir.join("out");
-    // Wait until the first case is journalled, then SIGKILL one worker mid-sweep.
-    let victim = loop {
+    // Wait until the first case is journalled, then SIGKILL one worker
+    // mid-sweep. A worker read from /proc may have exited before the kill
+    // reaches it (a worker that finished its last case): then another is
+    // chosen, while the coordinator runs.
+    loop {
         assert!(started.elapsed().as_secs() < 60, "sweep did not start");
+        assert!(
+            coord.try_wait().unwrap().is_none(),
+            "the sweep ended before a worker could be killed"
+        );
         let kids = children(coord.id());
         let journalled = std::fs::read_to_string(o.join("journal.jsonl"))
             .map(|t| t.lines().count() > 1)
             .unwrap_or(false);
         if journalled && kids.len() == 2 {
-            break kids[0];
+            let killed = Command::new("kill")
+                .args(["-9", &kids[0].to_string()])
+                .stderr(std::process::Stdio::null())
+                .status()
+                .unwrap();
+            if killed.success() {
+                break;
+            }
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
-    };
-    let killed = Command::new("kill")
-        .args(["-9", &victim.to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    }
     let out = coord.wait_with_output().unwrap();
     check_ok(&out, "sweep with a killed worker");
     eprintln!("{}", String::from_utf8_lossy(&out.stderr));
