@@ -313,7 +313,11 @@ fn children(pid: u32) -> Vec<u32> {
 fn killed_worker_is_detected_and_its_case_requeued() {
     let dir = scratch("kill");
     let started = std::time::Instant::now();
+    // On 128² (not the shared config's 32²) the sweep lasts long enough
+    // for a worker to be killed in it: on 32² an idle machine finished it
+    // in 60 ms, before the first case was journalled and seen here.
     let mut coord = sweep_cmd(&dir, "out", 2, "e")
+        .args(["--set", "grid.points=128"])
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
