@@ -199,20 +199,21 @@ struct Split {
     wj: Vec<f64>,
     /// Whether any cell has weight on node 1.
     node1: bool,
-    /// `M e_1`, `M e_2` (x and y each), the inverse of `Bᵀ M B` and of
-    /// `Bᵀ B` (`B`: the two force columns).
+    /// `M e_1`, `M e_2` (x and y each), `Bᵀ M B` and `Bᵀ B` (`B`: the two
+    /// force columns).
     me: [(Vec<f64>, Vec<f64>); 2],
-    gram_inv: [[f64; 2]; 2],
-    bb_inv: [[f64; 2]; 2],
+    gram: [[f64; 2]; 2],
+    bb: [[f64; 2]; 2],
 }
 
 /// Per-solve constants and scratch fields.
 struct Work<'a> {
     set: &'a Feasible<'a>,
     extra: Option<(&'a [f64], &'a [f64])>,
-    /// Own compliance of each cell `C_ii` (cut cells larger), m/Pa.
-    diag: Vec<f64>,
+    /// A whole cell's own compliance `C₀₀`, m/Pa, and the cut cells' extra
+    /// own compliance (ascending cells, [`Operator::extra_diagonal`]).
     c00: f64,
+    cut: Vec<(usize, f64)>,
     /// Scratch of the preconditioner.
     a: (Vec<f64>, Vec<f64>),
     b: (Vec<f64>, Vec<f64>),
@@ -234,8 +235,8 @@ impl Split {
             wj: z(),
             node1: false,
             me: [(z(), z()), (z(), z())],
-            gram_inv: [[0.0; 2]; 2],
-            bb_inv: [[0.0; 2]; 2],
+            gram: [[0.0; 2]; 2],
+            bb: [[0.0; 2]; 2],
         }
     }
 
@@ -309,13 +310,14 @@ impl<'a> Work<'a> {
     }
 
     /// Freezes the split `sp.stick` with directions `sp.n` and curvatures
-    /// `sp.kap`: the preconditioner's weights, `M e_k`, `(Bᵀ M B)⁻¹` and
-    /// `(Bᵀ B)⁻¹`.
+    /// `sp.kap`: the preconditioner's weights, `M e_k`, `Bᵀ M B` and `Bᵀ B`.
     fn freeze(&mut self, op: &mut Operator, sp: &mut Split, columns: bool) {
         let cells = self.set.cells;
         let (l_soft, l_node, l_jac) = (SOFT.ln(), NODE.ln(), JACOBI.ln());
         sp.node1 = false;
         let mut bb = [[0.0; 2]; 2];
+        // The cut cells, walked along with the (ascending) contact cells.
+        let mut cut = self.cut.iter().peekable();
         for &i in cells {
             if sp.stick[i] {
                 sp.w0[i] = 1.0;
@@ -343,11 +345,13 @@ impl<'a> Work<'a> {
             };
             sp.w0[i] = w0.sqrt();
             sp.w1[i] = w1.sqrt();
-            sp.wj[i] = wj / (self.diag[i] + sp.kap[i]);
+            while cut.next_if(|&&(c, _)| c < i).is_some() {}
+            let extra = cut.next_if(|&&(c, _)| c == i).map_or(0.0, |&(_, e)| e);
+            sp.wj[i] = wj / (self.c00 + extra + sp.kap[i]);
             sp.node1 |= w1 > 0.0;
         }
         bb[1][0] = bb[0][1];
-        sp.bb_inv = inverse2(bb);
+        sp.bb = bb;
         if !columns {
             return;
         }
@@ -372,13 +376,12 @@ impl<'a> Work<'a> {
         let off = 0.5 * (gram[0][1] + gram[1][0]);
         gram[0][1] = off;
         gram[1][0] = off;
-        sp.gram_inv = inverse2(gram);
+        sp.gram = gram;
     }
 
     /// `r −= B (Bᵀ B)⁻¹ Bᵀ r` (the residual update of projected CG).
     fn deflate(&self, sp: &Split, (rx, ry): (&mut [f64], &mut [f64])) {
-        let s = self.sums((rx, ry));
-        let y = mul2(sp.bb_inv, s);
+        let y = solve_or_zero(sp.bb, self.sums((rx, ry)));
         for &i in self.set.cells {
             if sp.stick[i] {
                 rx[i] -= y[0];
@@ -394,7 +397,7 @@ impl<'a> Work<'a> {
 
     /// `z −= M B (Bᵀ M B)⁻¹ Bᵀ z`: `M r` into `P_M r`.
     fn project(&self, sp: &Split, (zx, zy): (&mut [f64], &mut [f64])) {
-        let c = mul2(sp.gram_inv, self.sums((zx, zy)));
+        let c = solve_or_zero(sp.gram, self.sums((zx, zy)));
         let [(m1x, m1y), (m2x, m2y)] = &sp.me;
         for &i in self.set.cells {
             zx[i] -= c[0] * m1x[i] + c[1] * m2x[i];
@@ -416,7 +419,7 @@ impl<'a> Work<'a> {
     ) {
         let s = self.sums((xx, xy));
         let target = self.set.target;
-        let c = mul2(sp.gram_inv, [target[0] - s[0], target[1] - s[1]]);
+        let c = solve_or_zero(sp.gram, [target[0] - s[0], target[1] - s[1]]);
         let [(m1x, m1y), (m2x, m2y)] = &sp.me;
         for &i in self.set.cells {
             let (ax, ay) = (c[0] * m1x[i] + c[1] * m2x[i], c[0] * m1y[i] + c[1] * m2y[i]);
@@ -555,7 +558,7 @@ impl<'a> Work<'a> {
             };
             sp.nx[i] = nx;
             sp.ny[i] = ny;
-            sp.kap[i] = (-(nx * wx + ny * wy)).max(0.0) / b;
+            sp.kap[i] = curvature([nx, ny], [wx, wy], b);
             let (ox, oy) = (xx[i], xy[i]);
             xx[i] = b * nx;
             xy[i] = b * ny;
@@ -583,23 +586,19 @@ fn slips_along(sp: &Split, i: usize, w: [f64; 2], q: [f64; 2], limit: f64) -> bo
     norm(w[0] + r * q[0], w[1] + r * q[1]) > limit
 }
 
-fn inverse2(a: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
-    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-    if det.abs() <= 1e-300 {
-        return [[0.0; 2]; 2];
-    }
-    [
-        [a[1][1] / det, -a[0][1] / det],
-        [-a[1][0] / det, a[0][0] / det],
-    ]
+/// [`solve2`], or zero where the 2x2 matrix is singular (no slip cell's
+/// tangent and no stick cell: nothing to shift or project).
+#[inline]
+fn solve_or_zero(a: [[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
+    solve2(a, b).unwrap_or_default()
 }
 
+/// A slip cell's rim curvature `κ = max(−n·w, 0)/b`, m/Pa: its slip `w`
+/// (relative to the shift) pressing its traction, of direction `n`, onto
+/// the rim of radius `b`.
 #[inline]
-fn mul2(a: [[f64; 2]; 2], v: [f64; 2]) -> [f64; 2] {
-    [
-        a[0][0] * v[0] + a[0][1] * v[1],
-        a[1][0] * v[0] + a[1][1] * v[1],
-    ]
+fn curvature(n: [f64; 2], w: [f64; 2], b: f64) -> f64 {
+    (-(n[0] * w[0] + n[1] * w[1])).max(0.0) / b
 }
 
 /// The slip field `s = C q + e` of tractions `q` (`e`: the coupling term,
@@ -635,19 +634,14 @@ pub(crate) fn active_set(
 ) -> Result<Outcome, SolverError> {
     let len = qx.len();
     let cells = set.cells;
-    let c00 = op.tangential_self();
-    let mut diag = vec![c00; len];
-    if let Some(extra) = op.extra_diagonal() {
-        for (c, e) in extra {
-            diag[c] += e;
-        }
-    }
     let z = || vec![0.0; len];
+    let mut cut = op.extra_diagonal().unwrap_or_default();
+    cut.sort_unstable_by_key(|&(c, _)| c);
     let mut w = Work {
         set,
         extra,
-        diag,
-        c00,
+        c00: op.tangential_self(),
+        cut,
         a: (z(), z()),
         b: (z(), z()),
         e: (z(), z()),
@@ -678,8 +672,8 @@ pub(crate) fn active_set(
     };
     for &i in cells {
         if !sp.stick[i] {
-            let (wx, wy) = (sx[i] - d[0], sy[i] - d[1]);
-            sp.kap[i] = (-(sp.nx[i] * wx + sp.ny[i] * wy)).max(0.0) / set.bound(i);
+            let w = [sx[i] - d[0], sy[i] - d[1]];
+            sp.kap[i] = curvature([sp.nx[i], sp.ny[i]], w, set.bound(i));
         }
     }
     let mut frozen = false;

@@ -17,6 +17,9 @@
 //! history's uncoupled increments) preconditions the CG's stick cells with the
 //! Fourier inverse of the compliance (`StickPrecond`), which halves their
 //! iterations; the answer is the same problem's to the same KKT tolerance.
+//! With `TangentialMethod::ActiveSet` the first phase is instead the
+//! active-set iteration of [`crate::solve::active_set`]; the start's
+//! projection, the FISTA phase and the KKT test are the same.
 
 use crate::base::parallel::{Chunks, Threads};
 use crate::error::SolverError;
@@ -369,8 +372,9 @@ fn on_grid_taking(
     // Step 1/L, L the largest eigenvalue of the tangential block.
     let step = 1.0 / op.tangential_bound();
 
-    // Phase 1: projected conjugate gradient (below). Phase 2, only if phase 1
-    // did not converge: FISTA from where it stopped.
+    // Phase 1: the projected conjugate gradient (below) or the active-set
+    // iteration, as `prob.method` says. Phase 2, only if phase 1 did not
+    // converge: FISTA from where it stopped.
     let cg = match prob.method {
         TangentialMethod::ConjugateGradient => {
             let mut own = None;
