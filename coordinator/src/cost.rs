@@ -70,7 +70,8 @@ pub fn stress_seconds(spec: &CaseSpec, cfg: &crate::config::StressCfg) -> f64 {
     const PLANE_S: f64 = 0.06;
     const ROW_S: f64 = 0.018;
     const CRYSTAL: f64 = 1.05;
-    let planes = cfg.depths_um.iter().filter(|&&z| z != 0.0).count() as f64;
+    // The kernels less the surface's: the planes below it.
+    let planes = (stress_kernels(cfg) - 1) as f64;
     let rows = if cfg.slices {
         cfg.slice_rows as f64
     } else {

@@ -170,7 +170,7 @@ pub fn run_worker<K: WireKey>(run_id: &str, worker_index: usize) -> anyhow::Resu
     solver::set_tick_hook(Some(Box::new(move || ticking.borrow_mut().tick())));
     let mut cache = kernel_store::FileStore::cache();
     let mut keys: HashSet<KernelKey> = HashSet::new();
-    // The stress plan and fixed-depth planes of the last material and grid
+    // The stress plan and surface plane of the last material and grid
     // (`[stress]`), shared by the cases that follow.
     let mut stress_cache = StressCache::new();
     let mut next: WorkerMessage<K> = ToCoord::Ready(Ready {

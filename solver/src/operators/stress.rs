@@ -735,11 +735,6 @@ impl StressPlane {
     pub fn depth_m(&self) -> f64 {
         self.depth_m
     }
-
-    /// Bytes of its spectra.
-    pub fn bytes(&self) -> usize {
-        (self.kernel.len() + self.images.len()) * std::mem::size_of::<[C; 18]>()
-    }
 }
 
 /// The six stress components on the `n x n` cell centres of a plane (row
@@ -1564,20 +1559,13 @@ impl StressPlan {
         };
         let mut real = vec![0.0; m * m];
         let mut spec = vec![C::default(); self.fft.spectrum_len()];
+        // The offset of wrap-around index `i` (negative from `n` on), cells.
+        let offset = |i: usize| if i < n { i as f64 } else { i as f64 - m as f64 };
         for c in 0..18 {
             for iy in 0..m {
-                let y = if iy < n {
-                    iy as f64
-                } else {
-                    iy as f64 - m as f64
-                } * dy;
+                let y = offset(iy) * dy;
                 for ix in 0..m {
-                    let x = if ix < n {
-                        ix as f64
-                    } else {
-                        ix as f64 - m as f64
-                    } * dx;
-                    real[iy * m + ix] = at(c, x, y);
+                    real[iy * m + ix] = at(c, offset(ix) * dx, y);
                 }
             }
             self.fft.forward_full(&real, &mut spec);
@@ -1659,13 +1647,17 @@ pub fn von_mises(s: [f64; 6]) -> f64 {
 
 /// Tresca: the maximum shear stress `(σ₁ − σ₃)/2`.
 pub fn tresca(s: [f64; 6]) -> f64 {
-    let [a, _, c] = principal(s);
-    0.5 * (a - c)
+    tresca_of(principal(s))
 }
 
 /// The largest principal stress `σ₁`.
 pub fn max_principal(s: [f64; 6]) -> f64 {
     principal(s)[0]
+}
+
+/// Tresca of the principal stresses `[σ₁, σ₂, σ₃]` (largest first).
+pub fn tresca_of([a, _, c]: [f64; 3]) -> f64 {
+    0.5 * (a - c)
 }
 
 /// A maximum of a field: its value and index.

@@ -22,7 +22,9 @@
 use nalgebra::Matrix6;
 use serde::{Deserialize, Serialize};
 
-use crate::operators::stress::{principal, von_mises, Line, StressField, StressPlan, StressPlane};
+use crate::operators::stress::{
+    principal, tresca_of, von_mises, Line, StressField, StressPlan, StressPlane,
+};
 use crate::{CaseScalars, CaseSpec, Fields, Grid, Material, SolverError, TurningState};
 
 /// How the Crossland parameter is formed from the states computed.
@@ -309,24 +311,12 @@ pub struct StressCache {
     key: Option<(Material, Grid)>,
     plan: Option<StressPlan>,
     planes: Vec<StressPlane>,
-    /// Planes taken from the cache instead of built.
-    hits: usize,
 }
 
 impl StressCache {
     /// An empty cache.
     pub fn new() -> Self {
         Self::default()
-    }
-
-    /// Planes reused so far (a plane built is not counted).
-    pub fn hits(&self) -> usize {
-        self.hits
-    }
-
-    /// Bytes of the planes held.
-    pub fn bytes(&self) -> usize {
-        self.planes.iter().map(StressPlane::bytes).sum()
     }
 
     /// The plan of `material` on `grid` and the kept planes, made anew
@@ -354,14 +344,12 @@ impl StressCache {
 fn kept_plane(
     plan: &mut StressPlan,
     planes: &mut Vec<StressPlane>,
-    hits: &mut usize,
     depth_m: f64,
 ) -> Result<usize, SolverError> {
     if let Some(i) = planes
         .iter()
         .position(|p| p.depth_m().to_bits() == depth_m.to_bits())
     {
-        *hits += 1;
         return Ok(i);
     }
     planes.push(plan.plane(depth_m)?);
@@ -373,12 +361,11 @@ fn kept_plane(
 fn plane_at<'a>(
     plan: &mut StressPlan,
     kept: &'a mut Vec<StressPlane>,
-    hits: &mut usize,
     z: f64,
     own: &'a mut Option<StressPlane>,
 ) -> Result<&'a StressPlane, SolverError> {
     if z == 0.0 {
-        let i = kept_plane(plan, kept, hits, z)?;
+        let i = kept_plane(plan, kept, z)?;
         Ok(&kept[i])
     } else {
         Ok(own.insert(plan.plane(z)?))
@@ -398,8 +385,8 @@ pub fn compute(
     compute_with(req, spec, scalars, fields, turning, &mut StressCache::new())
 }
 
-/// [`compute`] with the plan and the fixed-depth planes of `cache` (a
-/// sweep's worker keeps one across its cases); the same numbers to the bit.
+/// [`compute`] with the plan and the surface plane of `cache` (a sweep's
+/// worker keeps one across its cases); the same numbers to the bit.
 pub fn compute_with(
     req: &StressRequest,
     spec: &CaseSpec,
@@ -418,7 +405,6 @@ pub fn compute_with(
     } else {
         vec![(None, &fields.p[..], &fields.qx[..], &fields.qy[..])]
     };
-    let mut hits = cache.hits;
     let (plan, kept) = cache.prepare(&spec.material, grid)?;
     let tractions: Vec<_> = states
         .iter()
@@ -458,10 +444,14 @@ pub fn compute_with(
     // One kernel per depth, applied to every state.
     // The slices: the rows deeper than the aliases reach all at once
     // (`StressPlan::slice`, no plane built), the others from their planes.
+    let direct: Vec<bool> = slice_depths
+        .iter()
+        .map(|&z| z != 0.0 && !plan.sums_aliases(z))
+        .collect();
     let deep: Vec<f64> = slice_depths
         .iter()
-        .copied()
-        .filter(|&z| z != 0.0 && !plan.sums_aliases(z))
+        .zip(&direct)
+        .filter_map(|(&z, &d)| d.then_some(z))
         .collect();
     let deep_rows = if deep.is_empty() {
         Vec::new()
@@ -469,8 +459,8 @@ pub fn compute_with(
         plan.slice(&deep, &tractions, &[along, across])?
     };
     let mut next_deep = 0;
-    for &z in &slice_depths {
-        if z != 0.0 && !plan.sums_aliases(z) {
+    for (&z, &direct) in slice_depths.iter().zip(&direct) {
+        if direct {
             for (s, rows) in out.iter_mut().zip(&deep_rows) {
                 s.along.push(rows[0][next_deep].clone());
                 s.across.push(rows[1][next_deep].clone());
@@ -480,7 +470,7 @@ pub fn compute_with(
         }
         // The slices' top row is the surface plane's, kept for SWT.
         let mut own = None;
-        let plane = plane_at(plan, kept, &mut hits, z, &mut own)?;
+        let plane = plane_at(plan, kept, z, &mut own)?;
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.along.push(plan.apply_line(plane, t, along));
             s.across.push(plan.apply_line(plane, t, across));
@@ -490,7 +480,7 @@ pub fn compute_with(
     let mut surface: Option<Vec<StressField>> = None;
     for &z in &depths_m {
         let mut own = None;
-        let plane = plane_at(plan, kept, &mut hits, z, &mut own)?;
+        let plane = plane_at(plan, kept, z, &mut own)?;
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.planes.push(plan.apply(plane, t));
         }
@@ -498,10 +488,9 @@ pub fn compute_with(
     // The surface plane for SWT: a plane of the request at z = 0, else its own.
     let on_surface = depths_m.iter().position(|&z| z == 0.0);
     if on_surface.is_none() {
-        let i = kept_plane(plan, kept, &mut hits, 0.0)?;
+        let i = kept_plane(plan, kept, 0.0)?;
         surface = Some(tractions.iter().map(|t| plan.apply(&kept[i], t)).collect());
     }
-    cache.hits = hits;
     let surface_of = |k: usize| -> &StressField {
         match (&surface, on_surface) {
             (Some(s), _) => &s[k],
@@ -563,10 +552,7 @@ pub fn compute_with(
         state_scalars.push(StateScalars {
             step: st.step,
             max_von_mises: best(&pts, &|i| von_mises(pts[i].0)),
-            max_tresca: best(&pts, &|i| {
-                let [a, _, c] = principals[i];
-                0.5 * (a - c)
-            }),
+            max_tresca: best(&pts, &|i| tresca_of(principals[i])),
             max_principal: best(&pts, &|i| principals[i][0]),
             surface_peak_along_force: surface_peak,
         });
