@@ -50,7 +50,7 @@ impl Load {
 /// The iteration of a tangential solve's first phase (both end, if they
 /// have not converged, in the same projected-gradient phase and are judged
 /// by the same KKT test).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum TangentialMethod {
     /// The projected conjugate gradient over the stick cells' tractions
     /// and the slip cells' rotation on their discs (Jacobi-preconditioned;
