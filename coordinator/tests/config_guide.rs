@@ -60,6 +60,8 @@ fn accepted_keys() -> BTreeSet<String> {
             normal: Some([0.0, 0.0, 1.0]),
             x_dir: Some([1.0, 0.0, 0.0]),
             equivalent: Some(iso),
+            hardness_gpa: Some(1.0),
+            shear_limit_gpa: Some(0.2),
         },
     );
     let surface: SurfaceCfg = toml::from_str(

@@ -437,7 +437,7 @@ fn solve<'py>(
     let scalars = to_py(py, &value)?;
     let fields = PyDict::new(py);
     let n = solved.fields.n;
-    for (name, data) in solved.fields.named() {
+    for (name, data) in solved.fields.present() {
         fields.set_item(name, PyArray1::from_slice(py, data).reshape([n, n])?)?;
     }
     // With [stress]: the arrays of the CLI's stress/*.npy, by file stem.

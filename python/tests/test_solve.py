@@ -310,3 +310,21 @@ angles_deg = [0.0]
     with pytest.warns(UserWarning, match="below 2 cells per pitch"):
         r = mpcontact.solve(cfg)
     assert r.scalars["converged"]
+
+
+def test_a_hardness_caps_the_pressure_and_returns_the_dent_as_the_cli(tmp_path, cli_solve):
+    # Table 1(a) Fe with H = 0.7 GPa, below Hertz's peak (0.86 GPa): the
+    # centre yields; Python and the CLI give the same bits, the dent too.
+    hardness_gpa = 0.7
+    path = tmp_path / "plastic.toml"
+    path.write_text(mindlin_text() + f"\n[materials.Fe]\nhardness_gpa = {hardness_gpa}\n")
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert_same_as_cli(res, case_json, cli_dir)
+    dent = res.fields["plastic"]
+    assert dent.tobytes() == np.load(cli_dir / "plastic.npy").tobytes()
+    plastic = res.scalars["plastic"]
+    assert plastic["hardness_pa"] == hardness_gpa * 1e9
+    assert plastic["plastic_area_m2"] > 0.0
+    assert dent.max() == plastic["penetration_max_m"] > 0.0
+    assert res.fields["p"].max() <= hardness_gpa * 1e9

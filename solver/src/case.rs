@@ -45,6 +45,7 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     let normal = res.solve_normal_from_rest(&NormalProblem {
         tolerance: spec.numerics.tolerance,
         max_iterations: spec.numerics.max_iterations,
+        hardness: spec.limits().hardness,
         ..NormalProblem::new(&h0, spec.load.normal_force_n)
     })?;
     check_inside(n, &normal.p)?;
@@ -77,6 +78,7 @@ fn solve_history_case(
     let normal = res.solve_normal_from_rest(&NormalProblem {
         tolerance: spec.numerics.tolerance,
         max_iterations: spec.numerics.max_iterations,
+        hardness: spec.limits().hardness,
         ..NormalProblem::new(h0, points[0].0)
     })?;
     check_inside(n, &normal.p)?;

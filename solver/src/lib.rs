@@ -102,7 +102,8 @@ pub use base::progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
 pub use case::solve_case;
 pub use error::SolverError;
 pub use model::material::{
-    hill_average, pair_influence, Anisotropic, ElasticModel, Elasticity, Isotropic, Material,
+    hill_average, pair_influence, Anisotropic, ElasticModel, Elasticity, Isotropic, Limits,
+    Material,
 };
 pub use model::radii::{
     Radii, APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
@@ -119,8 +120,8 @@ pub use operators::kernels::{
 };
 pub use operators::operator::{Operator, Spectra};
 pub use post::results::{
-    calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields, K_E_DEFINITION,
-    K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+    calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields, PlasticScalars,
+    K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
 pub use solve::history::{
     HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,

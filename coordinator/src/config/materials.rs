@@ -46,6 +46,35 @@ pub struct MaterialCfg {
     pub x_dir: Option<[f64; 3]>,
     /// Isotropic-equivalent constants for normalisation (default: Hill average).
     pub equivalent: Option<IsoCfg>,
+    /// Hardness H of the surface, GPa: the contact pressure is capped at H
+    /// (an elastic–perfectly plastic surface). A table with only
+    /// `hardness_gpa` / `shear_limit_gpa` adds them to the preset of its name.
+    pub hardness_gpa: Option<f64>,
+    /// Shear limit τ_c of the surface, GPa: the shear traction is capped at
+    /// min(μp, τ_c).
+    pub shear_limit_gpa: Option<f64>,
+}
+
+impl MaterialCfg {
+    /// How many of `isotropic`, `stiffness_gpa`, `cubic_gpa` the table gives.
+    fn elastic_keys(&self) -> usize {
+        [
+            self.isotropic.is_some(),
+            self.stiffness_gpa.is_some(),
+            self.cubic_gpa.is_some(),
+        ]
+        .iter()
+        .filter(|&&b| b)
+        .count()
+    }
+
+    /// The plastic limits of the table, in Pa.
+    fn limits(&self) -> solver::Limits {
+        solver::Limits {
+            hardness: self.hardness_gpa.map(|v| v * 1e9),
+            shear_limit: self.shear_limit_gpa.map(|v| v * 1e9),
+        }
+    }
 }
 
 /// The key in `[materials.NAME]` of a material parameter.
@@ -57,6 +86,8 @@ pub(super) fn material_key<'a>(param: &'a str, cfg: Option<&MaterialCfg>) -> &'a
         "stiffness" if cubic => "cubic_gpa",
         "stiffness" => "stiffness_gpa",
         "orientation" => "normal",
+        "hardness" => "hardness_gpa",
+        "shear_limit" => "shear_limit_gpa",
         other => other,
     }
 }
@@ -125,7 +156,9 @@ impl Config {
                 o.base
             )
         };
-        cubic(&o.name, cfg, o.normal, o.x_dir, &explain)
+        cubic(&o.name, cfg, o.normal, o.x_dir, &explain)?
+            .with_limits(cfg.limits())
+            .map_err(|e| self.explain(within("material", e), &o.base, ""))
     }
 
     /// The name of the sweep's first material (a single case's default):
@@ -209,7 +242,16 @@ impl Config {
     /// Resolves a material name given under the config key `key`.
     fn material_for(&self, key: &str, name: &str) -> Result<Material> {
         if let Some(m) = self.materials.get(name) {
-            return build_material(name, m, &|e| self.explain(within("material", e), name, ""));
+            let explain = |e| self.explain(within("material", e), name, "");
+            let elastic = if m.elastic_keys() == 0 && m.limits() != solver::Limits::default() {
+                // Limits added to a preset.
+                solver::presets::material(name).ok_or_else(|| {
+                    anyhow!("materials.{name}: `{name}` is not a preset (see `mpcontact materials`), so its table needs its elastic constants: one of `isotropic`, `stiffness_gpa`, `cubic_gpa`")
+                })?
+            } else {
+                build_material(name, m, &explain)?
+            };
+            return elastic.with_limits(m.limits()).map_err(explain);
         }
         solver::presets::material(name).ok_or_else(|| {
             anyhow!("{key}: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
@@ -225,16 +267,8 @@ fn build_material(
     explain: &dyn Fn(SolverError) -> anyhow::Error,
 ) -> Result<Material> {
     let key = |k: &str| format!("materials.{name}.{k}");
-    let given = [
-        m.isotropic.is_some(),
-        m.stiffness_gpa.is_some(),
-        m.cubic_gpa.is_some(),
-    ]
-    .iter()
-    .filter(|&&b| b)
-    .count();
-    if given != 1 {
-        bail!("materials.{name}: give exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa`");
+    if m.elastic_keys() != 1 {
+        bail!("materials.{name}: give exactly one of `isotropic`, `stiffness_gpa`, `cubic_gpa` (or, for a preset of that name, only `hardness_gpa` / `shear_limit_gpa`)");
     }
     if let Some(iso) = m.isotropic {
         if m.equivalent.is_some() {
@@ -324,6 +358,39 @@ mod tests {
             "{}",
             err(&not_pd, &[])
         );
+    }
+
+    #[test]
+    fn issue50_plastic_limits_add_to_presets_and_tables_or_are_explained() {
+        // On a preset: its constants, with the limits in Pa.
+        let hard = format!("{BASE}\n[materials.Fe]\nhardness_gpa = 1.5\nshear_limit_gpa = 0.2\n");
+        let c = Config::parse(&hard, &[]).unwrap();
+        let fe = c.material("Fe").unwrap();
+        assert_eq!(fe.limits.hardness, Some(1.5e9));
+        assert_eq!(fe.limits.shear_limit, Some(0.2e9));
+        assert_eq!(
+            fe.elasticity,
+            solver::presets::material("Fe").unwrap().elasticity
+        );
+        // Beside a table's own constants.
+        let own = format!(
+            "{BASE}\n[materials.soft]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nhardness_gpa = 0.5\n"
+        )
+        .replace("materials = [\"Fe\"]", "materials = [\"soft\"]");
+        let c = Config::parse(&own, &[]).unwrap();
+        assert_eq!(c.material("soft").unwrap().limits.hardness, Some(0.5e9));
+        // Wrong values name their key.
+        let negative = hard.replace("hardness_gpa = 1.5", "hardness_gpa = -1.0");
+        let e = err(&negative, &[]);
+        assert!(
+            e.contains("materials.Fe.hardness_gpa") && e.contains("positive"),
+            "{e}"
+        );
+        // Limits alone under a name that is no preset.
+        let orphan = format!("{BASE}\n[materials.alloy]\nhardness_gpa = 1.0\n")
+            .replace("materials = [\"Fe\"]", "materials = [\"alloy\"]");
+        let e = err(&orphan, &[]);
+        assert!(e.contains("not a preset"), "{e}");
     }
 
     #[test]

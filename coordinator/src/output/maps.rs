@@ -103,7 +103,8 @@ impl Figure for MapFigure<'_> {
     }
 }
 
-/// Writes `p.png`, `qx.png`, `qy.png`, `slip.png` and `stick.png` into `dir`.
+/// Writes `p.png`, `qx.png`, `qy.png`, `slip.png` and `stick.png` into `dir`
+/// (and `plastic.png`, the dent, on a surface with a hardness).
 /// `title` names the case (material, surface, ψ). Axes are x/a with a the
 /// apparent contact radius; tractions are normalised by the Hertz pressure p_H.
 pub fn write_maps(
@@ -135,7 +136,7 @@ pub fn write_maps(
             }
         })
         .collect();
-    let maps = [
+    let mut maps = vec![
         Map {
             file: "p.png",
             label: "p / p_H",
@@ -162,6 +163,15 @@ pub fn write_maps(
             values: status,
         },
     ];
+    // On a surface with a hardness: the dent (permanent plastic
+    // penetration), µm.
+    if !fields.plastic.is_empty() {
+        maps.push(Map {
+            file: "plastic.png",
+            label: "plastic penetration (µm)",
+            values: fields.plastic.iter().map(|w| w * 1e6).collect(),
+        });
+    }
     let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
     for m in &maps {
         let path = dir.join(m.file);

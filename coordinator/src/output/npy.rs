@@ -33,7 +33,7 @@ pub fn write_npy_2d(path: &Path, rows: usize, cols: usize, data: &[f64]) -> Resu
 /// Writes every field of a case into `dir` as `<name>.npy`.
 pub fn write_fields(dir: &Path, fields: &Fields) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, data) in fields.named() {
+    for (name, data) in fields.present() {
         write_npy(&dir.join(format!("{name}.npy")), fields.n, data)?;
     }
     Ok(())

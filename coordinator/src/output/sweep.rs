@@ -35,6 +35,32 @@ pub const CURVES_HEADER: &str =
 /// critical plane. A sweep without the section has the header above, to the byte.
 pub const RESULTS_STRESS_COLUMNS: &str = "max_von_mises_pa,max_von_mises_over_p_h,max_von_mises_x_m,max_von_mises_y_m,max_von_mises_z_m,max_tresca_pa,max_tresca_over_p_h,max_principal_pa,max_principal_over_p_h,surface_peak_pa,surface_peak_over_p_h,surface_peak_x_m,surface_peak_y_m,crossland_pa,crossland_z_m,swt_pa,swt_x_m,swt_y_m,swt_plane_deg";
 
+/// Columns `results.csv` gains when a case of the sweep has a hardness
+/// (`[materials.NAME] hardness_gpa`): the interface's hardness, the area at
+/// the hardness and its equivalent radius, the largest permanent plastic
+/// penetration and the dent's volume (empty for a case without one). A
+/// sweep without a hardness has the header above, to the byte.
+pub const RESULTS_PLASTIC_COLUMNS: &str =
+    "hardness_pa,plastic_area_m2,plastic_radius_m,plastic_penetration_max_m,dent_volume_m3";
+
+/// Column `curves.csv` gains when a case of the sweep has a hardness: the
+/// finest level's plastic area.
+pub const CURVES_PLASTIC_COLUMNS: &str = "plastic_area_m2";
+
+/// The cells of [`RESULTS_PLASTIC_COLUMNS`] of a case (empty without a
+/// plastic zone).
+fn plastic_cells(s: Option<&solver::PlasticScalars>) -> String {
+    let f = |g: fn(&solver::PlasticScalars) -> f64| opt(s.map(g));
+    [
+        f(|s| s.hardness_pa),
+        f(|s| s.plastic_area_m2),
+        f(|s| s.plastic_radius_m),
+        f(|s| s.penetration_max_m),
+        f(|s| s.dent_volume_m3),
+    ]
+    .join(",")
+}
+
 /// Columns `curves.csv` gains with `[stress]` (the finest level's case).
 pub const CURVES_STRESS_COLUMNS: &str =
     "max_von_mises_over_p_h,max_tresca_over_p_h,surface_peak_over_p_h,swt_pa";
@@ -166,7 +192,12 @@ pub struct Row<'a> {
 pub fn results_csv(rows: &[Row]) -> String {
     let axes = Axes::of(rows.iter().map(|r| r.key));
     let stress = rows.iter().any(|r| r.stress.is_some());
+    let plastic = rows.iter().any(|r| r.spec.limits().hardness.is_some());
     let mut out = header_with_axes(RESULTS_HEADER, axes);
+    if plastic {
+        out.push(',');
+        out.push_str(RESULTS_PLASTIC_COLUMNS);
+    }
     if stress {
         out.push(',');
         out.push_str(RESULTS_STRESS_COLUMNS);
@@ -204,6 +235,10 @@ pub fn results_csv(rows: &[Row]) -> String {
             f(|s| s.contact_radius_cells_m),
             f(|s| s.stick_radius_cells_m),
         );
+        if plastic {
+            out.push(',');
+            out.push_str(&plastic_cells(s.and_then(|s| s.plastic.as_ref())));
+        }
         if stress {
             out.push(',');
             out.push_str(&stress_cells(r.stress));
@@ -243,6 +278,8 @@ pub struct CurvePoint {
     pub dissipated: Option<Estimate>,
     /// With `[stress]`: the finest level's stress scalars.
     pub stress: Option<StressScalars>,
+    /// On a surface with a hardness: the finest level's plastic zone.
+    pub plastic: Option<solver::PlasticScalars>,
 }
 
 /// The curve points of `rows`: each material × surface × angle whose
@@ -300,6 +337,7 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             flat_calibration: rs[0].spec.surface == solver::Surface::Flat
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
             dissipated,
+            plastic: finest.plastic,
             stress: rs
                 .iter()
                 .rev()
@@ -319,11 +357,16 @@ pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
 pub fn curves_csv(points: &[CurvePoint]) -> String {
     let history = points.iter().any(|p| p.dissipated.is_some());
     let stress = points.iter().any(|p| p.stress.is_some());
+    let plastic = points.iter().any(|p| p.plastic.is_some());
     let axes = Axes::of(points.iter().map(|p| &p.key));
     let mut out = header_with_axes(CURVES_HEADER, axes);
     if history {
         out.push(',');
         out.push_str(CURVES_HISTORY_COLUMNS);
+    }
+    if plastic {
+        out.push(',');
+        out.push_str(CURVES_PLASTIC_COLUMNS);
     }
     if stress {
         out.push(',');
@@ -353,6 +396,9 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
                 opt(p.dissipated.as_ref().map(|d| d.value)),
                 opt(p.dissipated.as_ref().and_then(|d| d.err)),
             );
+        }
+        if plastic {
+            let _ = write!(out, ",{}", opt(p.plastic.map(|s| s.plastic_area_m2)));
         }
         if stress {
             let s = p.stress.as_ref();

@@ -68,6 +68,7 @@ mod tests {
                 name: "Cu(111)".into(),
                 elasticity: solver::Elasticity::Anisotropic(solver::Anisotropic(c)),
                 equivalent: iso,
+                limits: Default::default(),
             },
             surface,
             grid: solver::Grid::square(32, 1e-4),

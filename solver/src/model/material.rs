@@ -185,6 +185,56 @@ pub struct Material {
     /// Isotropic-equivalent constants: normalisation (Hertz a, p_H) and Mindlin K_E.
     /// Equal to the constants themselves for an isotropic material.
     pub equivalent: Isotropic,
+    /// The surface's plastic limits (none: elastic).
+    #[serde(default)]
+    pub limits: Limits,
+}
+
+/// The plastic limits of a body's surface, an elastic–perfectly plastic
+/// interface: the pressure cannot exceed the hardness (the material below
+/// flows and keeps the penetration), the shear traction cannot exceed the
+/// shear limit. `None`: no such limit (elastic).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Hardness H, Pa.
+    pub hardness: Option<f64>,
+    /// Shear limit τ_c, Pa.
+    pub shear_limit: Option<f64>,
+}
+
+impl Limits {
+    /// The limits of the interface between two bodies: the smaller of each
+    /// (the softer surface yields first).
+    pub fn softer(self, other: Limits) -> Limits {
+        let min = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(x), Some(y)) => Some(x.min(y)),
+            (x, None) => x,
+            (None, y) => y,
+        };
+        Limits {
+            hardness: min(self.hardness, other.hardness),
+            shear_limit: min(self.shear_limit, other.shear_limit),
+        }
+    }
+
+    /// Checks that each limit given is positive and finite; errors name it
+    /// (`hardness`, `shear_limit`).
+    pub fn validate(&self) -> Result<(), SolverError> {
+        for (name, v) in [
+            ("hardness", self.hardness),
+            ("shear_limit", self.shear_limit),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(SolverError::invalid(
+                        name,
+                        format!("must be positive and finite, got {v} Pa"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Material {
@@ -195,6 +245,7 @@ impl Material {
             name: name.to_string(),
             elasticity: Elasticity::Isotropic(iso),
             equivalent: iso,
+            limits: Limits::default(),
         })
     }
 
@@ -209,6 +260,7 @@ impl Material {
             name: name.to_string(),
             elasticity: Elasticity::Anisotropic(Anisotropic(stiffness)),
             equivalent,
+            limits: Limits::default(),
         };
         m.validate()?;
         Ok(m)
@@ -247,6 +299,13 @@ impl Material {
         Self::anisotropic(name, stiffness, equivalent)
     }
 
+    /// The same material with the plastic limits `limits`.
+    pub fn with_limits(mut self, limits: Limits) -> Result<Self, SolverError> {
+        limits.validate()?;
+        self.limits = limits;
+        Ok(self)
+    }
+
     /// The elastic model of this material.
     pub fn model(&self) -> &dyn ElasticModel {
         self.elasticity.model()
@@ -268,6 +327,7 @@ impl Material {
     /// parameter (`youngs`, `poisson`, `stiffness`, `equivalent`).
     pub fn validate(&self) -> Result<(), SolverError> {
         self.model().validate()?;
+        self.limits.validate()?;
         if !self.is_isotropic() {
             // The isotropic-equivalent constants only normalise; the paper's
             // Cu(111) has ν = 0.503, so only E > 0 and |ν| < 1 are required.

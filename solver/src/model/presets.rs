@@ -19,6 +19,7 @@ pub fn materials() -> Vec<Material> {
             name: name.into(),
             elasticity: Elasticity::Isotropic(c),
             equivalent: c,
+            limits: Default::default(),
         }
     };
     // (111) crystals: Table 2 stiffness; isotropic-equivalent E, ν of Table 1
@@ -30,6 +31,7 @@ pub fn materials() -> Vec<Material> {
             youngs: e_gpa * GPA,
             poisson: nu,
         },
+        limits: Default::default(),
     };
     vec![
         iso("Fe", 210.0, 0.3),

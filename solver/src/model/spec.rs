@@ -338,6 +338,38 @@ impl CaseSpec {
         num
     }
 
+    /// The plastic limits of the interface: the substrate's, and with an
+    /// elastic ball the smaller of the two bodies' (a rigid ball does not
+    /// yield).
+    pub fn limits(&self) -> crate::model::material::Limits {
+        match &self.indenter {
+            None => self.material.limits,
+            Some(ball) => self.material.limits.softer(ball.limits),
+        }
+    }
+
+    /// The pressure whose μ-multiple bounds the shear traction of each
+    /// cell: `p` itself, or with a shear limit τ_c `min(p, τ_c c / μ)`
+    /// (`c` the cell's cover, 1 where whole), so that the bound is
+    /// `min(μp, τ_c)` on the covered part. The tangential solvers, the
+    /// stick zone's reserve and the slip rescaling all read it.
+    pub fn friction_pressure<'a>(
+        &self,
+        p: &'a [f64],
+        cover: Option<&[f64]>,
+    ) -> std::borrow::Cow<'a, [f64]> {
+        let mu = self.load.friction;
+        match self.limits().shear_limit {
+            Some(tau) if mu > 0.0 => std::borrow::Cow::Owned(
+                p.iter()
+                    .enumerate()
+                    .map(|(i, &v)| v.min(tau * cover.map_or(1.0, |c| c[i]) / mu))
+                    .collect(),
+            ),
+            _ => std::borrow::Cow::Borrowed(p),
+        }
+    }
+
     /// The contact modulus E* of the pair from the isotropic-equivalent
     /// constants, `1/E* = Σ (1 − νᵢ²)/Eᵢ` (the substrate's plane-strain
     /// modulus for a rigid ball): Hertz normalisation.

@@ -100,6 +100,26 @@ pub struct CaseScalars {
     /// (the other scalars then describe the path's final state).
     #[serde(default)]
     pub history: Option<HistoryOutput>,
+    /// The plastic zone, on a surface with a hardness (`None`: elastic).
+    #[serde(default)]
+    pub plastic: Option<PlasticScalars>,
+}
+
+/// The plastic zone of a case on an elastic–perfectly plastic surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlasticScalars {
+    /// The interface's hardness H (the softer body's), Pa.
+    pub hardness_pa: f64,
+    /// Area of the cells whose pressure is at the hardness in the final
+    /// state (their covered part on cut cells), m².
+    pub plastic_area_m2: f64,
+    /// Equivalent radius of that area, `sqrt(A/π)`, m.
+    pub plastic_radius_m: f64,
+    /// Largest permanent plastic penetration (the dent; after a load
+    /// path, accumulated over it), m.
+    pub penetration_max_m: f64,
+    /// Volume of the dent, `ΔA Σ w`, m³.
+    pub dent_volume_m3: f64,
 }
 
 /// Surface fields of a solved case, each `n x n`, row-major `[iy][ix]` (y rows, x columns).
@@ -125,9 +145,22 @@ pub struct Fields {
     pub uy: Vec<f64>,
     /// Surface displacement z (into the body), m.
     pub uz: Vec<f64>,
+    /// Permanent plastic penetration (the dent), m; empty on an elastic
+    /// surface. Not one of [`Fields::named`]: sweeps do not carry it.
+    pub plastic: Vec<f64>,
 }
 
 impl Fields {
+    /// Every field the case has with its file name: [`Fields::named`],
+    /// then `plastic` on a surface with a hardness.
+    pub fn present(&self) -> Vec<(&'static str, &Vec<f64>)> {
+        let mut all = self.named().to_vec();
+        if !self.plastic.is_empty() {
+            all.push(("plastic", &self.plastic));
+        }
+        all
+    }
+
     /// The fields with their file names, in a fixed order.
     pub fn named(&self) -> [(&'static str, &Vec<f64>); 9] {
         [
@@ -244,6 +277,7 @@ pub(crate) fn reduce(
     let ContactState {
         p,
         approach,
+        plastic,
         tangential,
         normal_report,
         normal_iterations,
@@ -333,7 +367,8 @@ pub(crate) fn reduce(
     let radii = spec.numerics.radii;
     let a_app = apparent_radius(radii, &grid, &contact, &p, terrain);
     let c_app = if has_stick_set {
-        let reserve = friction_reserve(friction, &p, (&qx, &qy));
+        let bound = spec.friction_pressure(&p, cover);
+        let reserve = friction_reserve(friction, &bound, (&qx, &qy));
         apparent_radius(radii, &grid, &stick_in_contact, &reserve, terrain)
     } else {
         a_app
@@ -370,7 +405,23 @@ pub(crate) fn reduce(
         seconds: started.elapsed().as_secs_f64(),
         kernel_seconds,
         history,
+        plastic: None,
     };
+    if let Some(hardness) = spec.limits().hardness {
+        // The cells at the cap, as the normal solver sets it (hardness
+        // times cover, to the bit).
+        let capped: Vec<bool> = (0..len)
+            .map(|i| p[i] > 0.0 && p[i] >= hardness * cover.map_or(1.0, |c| c[i]))
+            .collect();
+        let area = covered_area(&capped, cover, da);
+        s.plastic = Some(PlasticScalars {
+            hardness_pa: hardness,
+            plastic_area_m2: area,
+            plastic_radius_m: (area / std::f64::consts::PI).sqrt(),
+            penetration_max_m: plastic.iter().cloned().fold(0.0, f64::max),
+            dent_volume_m3: plastic.iter().sum::<f64>() * da,
+        });
+    }
     let annulus = c < a && c_app < a_app && c >= min_radius;
     if fnorm > 0.0 && (is_history || !converged) {
         if annulus {
@@ -419,6 +470,7 @@ pub(crate) fn reduce(
         ux,
         uy,
         uz,
+        plastic,
     };
     Ok(CaseOutput {
         scalars: s,

@@ -98,6 +98,10 @@ pub(crate) struct ContactState {
     pub p: Vec<f64>,
     /// Rigid-body approach δz, m.
     pub approach: f64,
+    /// Plastic penetration per cell under the last normal solve's
+    /// separation, m (empty on an elastic surface; see
+    /// [`NormalSolution::plastic`]).
+    pub plastic: Vec<f64>,
     /// The last tangential solution (without a tangential force: no
     /// tractions, every contact cell sticks).
     pub tangential: TangentialSolution,
@@ -207,6 +211,7 @@ pub(crate) fn solve_step(
     let mut normal_iterations = normal0.report.iterations;
     let mut normal_report = normal0.report;
     let mut approach = normal0.approach;
+    let mut plastic = normal0.plastic;
     let mut p = normal0.p;
     drop(normal0.uz);
     let force = match step.target {
@@ -290,8 +295,11 @@ pub(crate) fn solve_step(
             } else {
                 0.0
             };
+            // The friction bound's pressure (the pressure itself without a
+            // shear limit).
+            let bound = spec.friction_pressure(&p, res.operator.cover());
             let prob = TangentialProblem {
-                p: &p,
+                p: &bound,
                 friction: spec.load.friction,
                 force,
                 extra: has_extra.then_some((&ex[..], &ey[..])),
@@ -318,7 +326,7 @@ pub(crate) fn solve_step(
             let mut tan = match (step.target, last.take()) {
                 // Displacement control: the shift is imposed, the force a result.
                 (Target::Shift(shift), pass) => res.solve_displacement(&DisplacementProblem {
-                    p: &p,
+                    p: &bound,
                     friction: spec.load.friction,
                     shift,
                     extra: prob.extra,
@@ -363,6 +371,7 @@ pub(crate) fn solve_step(
                 tolerance: normal_tol,
                 max_iterations: num.max_iterations,
                 p_init: Some(&p),
+                hardness: spec.limits().hardness,
                 ..NormalProblem::new(h0, load)
             })?;
             normal_iterations += nsol.report.iterations;
@@ -374,10 +383,14 @@ pub(crate) fn solve_step(
                 .sum::<f64>()
                 * da
                 / load;
-            rescale_slip(&mut tan, &p, &nsol.p, spec.load.friction, drive);
+            let new_bound = spec.friction_pressure(&nsol.p, res.operator.cover());
+            rescale_slip(&mut tan, &bound, &new_bound, spec.load.friction, drive);
+            drop(new_bound);
+            drop(bound);
             last = Some(tan);
             p = nsol.p;
             approach = nsol.approach;
+            plastic = nsol.plastic;
             // One more tangential solve at the updated pressure closes the loop.
             if coupling_change < num.coupling_tolerance && exact_pass {
                 coupling_converged = true;
@@ -401,6 +414,7 @@ pub(crate) fn solve_step(
     Ok(ContactState {
         p,
         approach,
+        plastic,
         tangential,
         normal_report,
         normal_iterations,

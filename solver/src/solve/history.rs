@@ -178,9 +178,16 @@ pub(crate) fn solve_history(
 
     // State after frictionless normal loading.
     let p0 = normal0.p.clone();
+    // On a surface with a hardness, the plastic penetration is permanent:
+    // every increment's adds to the dent, and the separation the next
+    // increment sees is the initial one plus the dent (unloading leaves it).
+    let mut dent = normal0.plastic.clone();
+    let mut dented: Option<Vec<f64>> =
+        (!dent.is_empty()).then(|| h0.iter().zip(&dent).map(|(h, d)| h + d).collect());
     let mut last = ContactState {
         p: normal0.p,
         approach: normal0.approach,
+        plastic: normal0.plastic,
         tangential: crate::solve::tangential::TangentialSolution {
             qx: vec![0.0; len],
             qy: vec![0.0; len],
@@ -242,6 +249,7 @@ pub(crate) fn solve_history(
                 rows.push(r);
                 continue;
             }
+            let h_now = dented.as_deref().unwrap_or(h0);
             // The normal solve at the new load, from the last pressure (with
             // coupling, under the last tractions' normal displacement).
             let normal = if p_k == p_prev {
@@ -249,6 +257,8 @@ pub(crate) fn solve_history(
                     p: last.p.clone(),
                     uz: Vec::new(),
                     approach: last.approach,
+                    // Nothing new flows at an unchanged load.
+                    plastic: Vec::new(),
                     report: crate::solve::normal::NormalReport {
                         iterations: 0,
                         ..last.normal_report
@@ -268,7 +278,8 @@ pub(crate) fn solve_history(
                     tolerance: num.tolerance,
                     max_iterations: num.max_iterations,
                     p_init: Some(&last.p),
-                    ..NormalProblem::new(h0, p_k)
+                    hardness: spec.limits().hardness,
+                    ..NormalProblem::new(h_now, p_k)
                 })?
             };
             // Force control: the force at the increment's end; displacement
@@ -294,7 +305,7 @@ pub(crate) fn solve_history(
             let state = solve_step(
                 res,
                 spec,
-                h0,
+                h_now,
                 normal,
                 &Step {
                     normal_force_n: p_k,
@@ -356,6 +367,12 @@ pub(crate) fn solve_history(
             }
             rows.push(r);
             (ux, uy) = (vx, vy);
+            if !state.plastic.is_empty() {
+                dent.iter_mut()
+                    .zip(&state.plastic)
+                    .for_each(|(d, w)| *d += w);
+                dented = Some(h0.iter().zip(&dent).map(|(h, d)| h + d).collect());
+            }
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
         }
@@ -365,6 +382,8 @@ pub(crate) fn solve_history(
     // The final state's shift is δt from the start of the path, not the
     // last increment's.
     last.tangential.shift = delta_t;
+    // The final state's plastic penetration is the whole path's dent.
+    last.plastic = dent;
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
@@ -397,7 +416,8 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
     let stick: Vec<bool> = (0..len).map(|i| contact[i] && tan.stick[i]).collect();
     let count = |v: &[bool]| covered_area(v, terrain.cover.as_deref(), da);
     let stick_radius = if stick.iter().any(|&b| b) {
-        let reserve = friction_reserve(mu, p, (&tan.qx, &tan.qy));
+        let bound = spec.friction_pressure(p, terrain.cover.as_deref());
+        let reserve = friction_reserve(mu, &bound, (&tan.qx, &tan.qy));
         apparent_radius(spec.numerics.radii, &grid, &stick, &reserve, terrain)
     } else {
         0.0

@@ -41,6 +41,11 @@ pub struct NormalSolution {
     pub uz: Vec<f64>,
     /// Rigid-body approach δz, m (gap `g = h0 + extra + uz − δz`).
     pub approach: f64,
+    /// Plastic penetration per cell, m: on the cells whose pressure is at
+    /// the cap ([`NormalProblem::hardness`]), `δz − (h0 + extra + uz)`, the
+    /// depth by which the surface has flowed below its elastic position;
+    /// zero elsewhere. Empty without a hardness.
+    pub plastic: Vec<f64>,
     /// Convergence.
     pub report: NormalReport,
 }
@@ -125,6 +130,7 @@ struct RestContact {
     tolerance: f64,
     max_iterations: usize,
     options: NormalOptions,
+    hardness: Option<f64>,
     solution: NormalSolution,
 }
 
@@ -139,6 +145,7 @@ impl RestContact {
             && self.tolerance.to_bits() == prob.tolerance.to_bits()
             && self.max_iterations == prob.max_iterations
             && self.options == prob.options
+            && self.hardness.map(f64::to_bits) == prob.hardness.map(f64::to_bits)
             && same(&self.h0, prob.h0)
             && match (&self.cover, cover) {
                 (None, None) => true,
@@ -231,6 +238,9 @@ struct Level<'a> {
     tolerance: f64,
     max_iterations: usize,
     precondition: bool,
+    /// The pressure cap per cell (the hardness times the cell's cover),
+    /// Pa; `None`: elastic.
+    cap: Option<&'a [f64]>,
 }
 
 /// Iterations after which `u = K p` is recomputed even if it could be updated.
@@ -255,7 +265,11 @@ fn polonsky_keer(
         tolerance,
         max_iterations,
         precondition,
+        cap,
     } = *level;
+    if let Some(cap) = cap {
+        return plastic_zone(op, level, cap, p, u);
+    }
     let len = h.len();
     let threads = op.threads();
     let chunks = Chunks::flat(len);
@@ -481,6 +495,159 @@ fn polonsky_keer(
     Ok(report)
 }
 
+/// Largest number of plastic-zone updates of a capped solve (each an
+/// elastic solve from the last); the zone of a sphere settles in a few.
+const MAX_ZONE_UPDATES: usize = 100;
+
+/// Relative slack of the zone's tests: a cell joins when its pressure
+/// exceeds its cap by this fraction, and leaves when its gap exceeds the
+/// approach by this fraction of the largest displacement.
+const ZONE_SLACK: f64 = 1e-9;
+
+/// Relative margin below its cap at which a cell of a warm start begins
+/// in the plastic zone (an interpolated coarse solution carries the cap to
+/// round-off).
+const ZONE_START: f64 = 1e-6;
+
+/// Tolerance of a capped solve's elastic solves while its plastic zone
+/// moves.
+const SETTLING_TOLERANCE: f64 = 1e-4;
+
+/// The separation that keeps a cell of the plastic zone out of the elastic
+/// contact around it, m (gaps are micrometres; a cell so far is never
+/// admitted, and its square stays finite).
+const OUT_OF_REACH: f64 = 1e30;
+
+/// The normal contact with the pressure capped at `cap` per cell (an
+/// elastic–perfectly plastic surface: `0 ≤ p ≤ cap`, a capped cell's
+/// surface may lie below the indenter, by its plastic penetration). The
+/// plastic zone is iterated around the elastic solver: with the capped
+/// cells carrying their cap (their displacement added to the others'
+/// separation, their load taken off the total) the rest is an elastic
+/// contact, solved by [`polonsky_keer`] from the last pressure; then the
+/// cells of that contact pushed above their cap join the zone and the
+/// capped cells whose surface no longer reaches the indenter leave it,
+/// until neither happens. A cell in the zone is kept out of the elastic
+/// contact by the separation [`OUT_OF_REACH`]. On return `p` carries the
+/// caps on the zone and `u = K p`.
+fn plastic_zone(
+    op: &mut impl ZzApply,
+    level: &Level,
+    cap: &[f64],
+    p: &mut [f64],
+    u: &mut [f64],
+) -> Result<NormalReport, SolverError> {
+    let Level { h, da, load_n, .. } = *level;
+    let len = h.len();
+    // The zone a warm start (or an interpolated coarse solution) had: the
+    // coupling passes of a case and the increments of a path start next to
+    // their zone (circle-B of the quick sweep: 7 updates in every pass
+    // from an empty zone).
+    let mut zone: Vec<bool> = (0..len)
+        .map(|i| p[i] >= cap[i] * (1.0 - ZONE_START))
+        .collect();
+    let mut report = NormalReport::default();
+    let (mut p_zone, mut u_zone, mut h_in) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+    // While the zone moves, its elastic solves stop early; once it holds,
+    // one solve to the tolerance decides.
+    let mut settling = true;
+    for _ in 0..MAX_ZONE_UPDATES {
+        let mut carried: f64 = (0..len).filter(|&i| zone[i]).map(|i| cap[i]).sum();
+        if carried * da >= load_n {
+            // The zone alone would carry the load (after a join it cannot:
+            // a cell joins when its pressure exceeds its cap; a start may):
+            // release its cells whose surface stands highest until it does
+            // not.
+            let gap = |i: usize| h[i] + u[i];
+            let mut order: Vec<usize> = (0..len).filter(|&i| zone[i]).collect();
+            order.sort_by(|&a, &b| gap(b).total_cmp(&gap(a)));
+            for i in order {
+                if carried * da < load_n {
+                    break;
+                }
+                zone[i] = false;
+                p[i] = cap[i];
+                carried -= cap[i];
+            }
+        }
+        for i in 0..len {
+            p_zone[i] = if zone[i] { cap[i] } else { 0.0 };
+        }
+        if zone.iter().any(|&z| z) {
+            op.apply_zz(&p_zone, &mut u_zone);
+            report.applications += 1;
+        } else {
+            u_zone.iter_mut().for_each(|v| *v = 0.0);
+        }
+        for i in 0..len {
+            if zone[i] {
+                h_in[i] = OUT_OF_REACH;
+                p[i] = 0.0;
+            } else {
+                h_in[i] = h[i] + u_zone[i];
+            }
+        }
+        let inner = Level {
+            h: &h_in,
+            load_n: load_n - carried * da,
+            cap: None,
+            tolerance: if settling {
+                level.tolerance.max(SETTLING_TOLERANCE)
+            } else {
+                level.tolerance
+            },
+            ..*level
+        };
+        let rep = polonsky_keer(op, &inner, p, u)?;
+        report.iterations += rep.iterations;
+        report.applications += rep.applications;
+        report.change = rep.change;
+        for i in 0..len {
+            if zone[i] {
+                p[i] = cap[i];
+            }
+            u[i] += u_zone[i];
+        }
+        if !rep.converged {
+            break;
+        }
+        // The approach of the elastic part, from the total displacement.
+        let gap = |i: usize| h[i] + u[i];
+        let (mut s, mut nc) = (0.0, 0usize);
+        for i in 0..len {
+            if !zone[i] && p[i] > 0.0 {
+                s += gap(i);
+                nc += 1;
+            }
+        }
+        let approach = s / nc.max(1) as f64;
+        // A cell on the zone's edge after a reloading sits at its cap with
+        // its gap closed, both to round-off: the slack keeps it from
+        // joining and leaving in turn (a dented surface reloaded cycled
+        // for 100 updates without it).
+        let reach = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let (mut joined, mut left) = (0usize, 0usize);
+        for i in 0..len {
+            if zone[i] && gap(i) > approach + ZONE_SLACK * reach {
+                // Lifted off its cap: back to the elastic contact.
+                zone[i] = false;
+                left += 1;
+            } else if !zone[i] && p[i] > cap[i] * (1.0 + ZONE_SLACK) {
+                zone[i] = true;
+                joined += 1;
+            }
+        }
+        if joined == 0 && left == 0 {
+            if !settling || level.tolerance >= SETTLING_TOLERANCE {
+                report.converged = true;
+                break;
+            }
+            settling = false;
+        }
+    }
+    Ok(report)
+}
+
 /// Gives the cells outside the contact set that interpenetrate (`g < 0`,
 /// with `g` the gap less the contact cells' mean) a pressure proportional to
 /// their overlap, the largest equal to the mean contact pressure, and
@@ -529,6 +696,10 @@ pub struct NormalProblem<'a> {
     pub p_init: Option<&'a [f64]>,
     /// Nested start and preconditioning.
     pub options: NormalOptions,
+    /// The surface's hardness H, Pa: the pressure is capped at H on the
+    /// covered part of every cell (an elastic–perfectly plastic surface);
+    /// `None`: elastic, no cap.
+    pub hardness: Option<f64>,
 }
 
 impl<'a> NormalProblem<'a> {
@@ -543,6 +714,7 @@ impl<'a> NormalProblem<'a> {
             max_iterations: 5000,
             p_init: None,
             options: NormalOptions::default(),
+            hardness: None,
         }
     }
 }
@@ -563,6 +735,7 @@ pub fn solve_normal(
         max_iterations,
         p_init,
         options,
+        hardness,
     } = *prob;
     let grid = op.grid();
     let len = grid.len();
@@ -573,6 +746,20 @@ pub fn solve_normal(
             format!("the normal load must be positive and finite, got {load_n} N"),
         ));
     }
+    if let Some(hv) = hardness {
+        if !(hv.is_finite() && hv > 0.0) {
+            return Err(SolverError::invalid(
+                "hardness",
+                format!("the hardness must be positive and finite, got {hv} Pa"),
+            ));
+        }
+    }
+    // The cap of a cut cell is the hardness on its covered part: a cell's
+    // pressure is its mean over the whole cell.
+    let caps: Option<Vec<f64>> = hardness.map(|hv| match op.cover() {
+        Some(cover) => cover.iter().map(|c| hv * c).collect(),
+        None => vec![hv; len],
+    });
     let h: Vec<f64> = match extra_gap {
         Some(e) => h0.iter().zip(e).map(|(a, b)| a + b).collect(),
         None => h0.to_vec(),
@@ -584,6 +771,7 @@ pub fn solve_normal(
         tolerance,
         max_iterations,
         precondition: options.precondition,
+        cap: caps.as_deref(),
     };
     let mut coarse_iterations = 0;
     let mut p = match p_init {
@@ -594,14 +782,20 @@ pub fn solve_normal(
                 default_start(&h)
             } else {
                 // Separations restricted down the chain, finest first.
+                // (The caps too: a coarse cell's pressure is the mean of
+                // its four.)
                 let mut hs = vec![restrict(&h, grid.n)];
+                let mut cs = vec![caps.as_deref().map(|c| restrict(c, grid.n))];
                 for l in 1..levels.len() {
-                    let next = restrict(&hs[l - 1], levels[l - 1].grid().n);
+                    let n_above = levels[l - 1].grid().n;
+                    let next = restrict(&hs[l - 1], n_above);
                     hs.push(next);
+                    let next = cs[l - 1].as_deref().map(|c| restrict(c, n_above));
+                    cs.push(next);
                 }
                 let coarse_tol = tolerance.max(COARSE_TOLERANCE);
                 let mut start: Option<Vec<f64>> = None;
-                for (level, hl) in levels.iter_mut().zip(&hs).rev() {
+                for ((level, hl), cl) in levels.iter_mut().zip(&hs).zip(&cs).rev() {
                     let g = level.grid();
                     let mut pl = match start.take() {
                         Some(v) => v,
@@ -612,6 +806,7 @@ pub fn solve_normal(
                         h: hl,
                         da: g.cell_area(),
                         tolerance: coarse_tol,
+                        cap: cl.as_deref(),
                         ..fine
                     };
                     let rep = polonsky_keer(level, &coarse, &mut pl, &mut ul);
@@ -643,25 +838,39 @@ pub fn solve_normal(
     report.coarse_iterations = coarse_iterations;
     // Final state and residuals from the returned pressure.
     op.normal(&p, &mut u);
-    let (mut s, mut nc) = (0.0, 0usize);
+    // The approach is the gap of the cells in elastic contact (below their
+    // caps); with every contact cell capped, the largest capped gap.
+    let at_cap = |i: usize| caps.as_ref().is_some_and(|c| p[i] >= c[i]);
+    let (mut s, mut nc, mut top) = (0.0, 0usize, f64::NEG_INFINITY);
     for i in 0..len {
-        if p[i] > 0.0 {
+        if at_cap(i) {
+            top = top.max(u[i] + h[i]);
+        } else if p[i] > 0.0 {
             s += u[i] + h[i];
             nc += 1;
         }
     }
-    if nc == 0 {
+    if nc == 0 && !top.is_finite() {
         return Err(SolverError::invalid(
             "solver",
             "normal solver lost all contact (pressure vanished); check the geometry",
         ));
     }
-    let approach = s / nc as f64;
+    let approach = if nc > 0 { s / nc as f64 } else { top };
     let scale = approach.abs().max(f64::MIN_POSITIVE);
     let (mut gap_res, mut pen) = (0.0_f64, 0.0_f64);
+    let mut plastic = Vec::new();
+    if caps.is_some() {
+        plastic = vec![0.0; len];
+    }
     for i in 0..len {
         let gap = u[i] + h[i] - approach;
-        if p[i] > 0.0 {
+        if at_cap(i) {
+            // A capped cell's surface reaches below the indenter (plastic
+            // penetration); one above it should have been released.
+            gap_res = gap_res.max(gap.max(0.0) / scale);
+            plastic[i] = (-gap).max(0.0);
+        } else if p[i] > 0.0 {
             gap_res = gap_res.max(gap.abs() / scale);
         } else {
             pen = pen.max((-gap).max(0.0) / scale);
@@ -674,6 +883,7 @@ pub fn solve_normal(
         p,
         uz: u,
         approach,
+        plastic,
         report,
     })
 }
@@ -681,7 +891,7 @@ pub fn solve_normal(
 /// [`solve_normal`] of a problem without warm start or extra gap (the
 /// frictionless contact a case starts from), or the solution kept from the
 /// last such solve on this operator when it was of the same problem to the
-/// bit (separation, load, tolerance, budget, options and the operator's
+/// bit (separation, load, tolerance, budget, options, hardness and the operator's
 /// cover): the solve is deterministic, so the result is the same bits. A
 /// sweep's force directions share their contact from rest: the quick sweep
 /// solved 8 such problems 56 times, about 20 of each case's 45 normal
@@ -714,6 +924,7 @@ pub fn solve_normal_from_rest(
             tolerance: prob.tolerance,
             max_iterations: prob.max_iterations,
             options: prob.options,
+            hardness: prob.hardness,
             solution: solution.clone(),
         });
     }

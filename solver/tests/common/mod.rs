@@ -1,6 +1,8 @@
 //! Shared set-up of the validation tests: the paper's Table 1a case.
 #![allow(dead_code)]
 
+pub mod axisym;
+
 use solver::influence::isotropic_cell;
 use solver::normal::{solve_normal, NormalCache, NormalProblem};
 use solver::tangential::{

@@ -1,0 +1,513 @@
+//! The elastic–perfectly plastic surface (issue #50): the pressure capped at
+//! the hardness H, the plastic penetration kept. Checked against the two
+//! limits (H above the elastic peak: the elastic contact; H small: p = H on
+//! the whole contact, whose area is then P/H) and against an independent
+//! axisymmetric solution of the same problem built here: ring elements with
+//! the closed-form displacements of uniformly loaded discs (no FFT, no 3-D
+//! kernel), solved by an active-set method with dense linear algebra.
+mod common;
+
+use common::axisym::disc_pressure;
+use common::LOAD_1A;
+use nalgebra::{DMatrix, DVector};
+use solver::influence::isotropic_cell;
+use solver::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
+use solver::{solve_case, Grid, KernelCache, Limits, LoadHistory, Operator};
+use std::f64::consts::PI;
+
+/// Table 1a: Fe under an 18 mm sphere.
+const E: f64 = 210.0e9;
+const NU: f64 = 0.3;
+const R: f64 = 18.0e-3;
+
+fn hertz() -> (f64, f64) {
+    let a = (3.0 * LOAD_1A * R / (4.0 * E / (1.0 - NU * NU))).cbrt();
+    (a, 3.0 * LOAD_1A / (2.0 * PI * a * a))
+}
+
+/// The operator and the sphere's separation on `n x n` cells of `d`.
+fn sphere(n: usize, d: f64) -> (Operator, Vec<f64>) {
+    let grid = Grid { n, dx: d, dy: d };
+    let g = E / (2.0 * (1.0 + NU));
+    let op = Operator::build(grid, |x, y| isotropic_cell(g, NU, x, y, d, d));
+    let h = (0..grid.len())
+        .map(|i| {
+            let (x, y) = (grid.x(i % n), grid.y(i / n));
+            (x * x + y * y) / (2.0 * R)
+        })
+        .collect();
+    (op, h)
+}
+
+fn solve(op: &mut Operator, h: &[f64], load: f64, hardness: Option<f64>) -> NormalSolution {
+    let mut cache = NormalCache::new(op);
+    let sol = solve_normal(
+        op,
+        &mut cache,
+        &NormalProblem {
+            hardness,
+            ..NormalProblem::new(h, load)
+        },
+    )
+    .unwrap();
+    assert!(sol.report.converged, "{:?}", sol.report);
+    sol
+}
+
+#[test]
+fn a_cap_above_the_elastic_peak_changes_nothing_and_a_low_cap_spreads_p_equal_h() {
+    let (a, p0) = hertz();
+    let d = a / 20.0;
+    let (mut op, h) = sphere(96, d);
+    let elastic = solve(&mut op, &h, LOAD_1A, None);
+    assert!(elastic.plastic.is_empty());
+    let pmax = elastic.p.iter().cloned().fold(0.0, f64::max);
+    // Above the peak: the same contact to the solver's tolerance.
+    let high = solve(&mut op, &h, LOAD_1A, Some(1.5 * pmax));
+    let dp = (0..h.len())
+        .map(|i| (high.p[i] - elastic.p[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(dp < 1e-6 * pmax, "max |Δp| / p_max = {:e}", dp / pmax);
+    assert!((high.approach - elastic.approach).abs() < 1e-8 * elastic.approach);
+    assert!(high.plastic.iter().all(|&w| w == 0.0));
+    // Far below: every contact cell at H but those of one ring of the
+    // grid's symmetry (up to 8 cells of equal separation), which share the
+    // rest (the load is not a whole number of cells at H); so the area is
+    // P/H to within that ring.
+    let hard = 0.1 * p0;
+    let low = solve(&mut op, &h, LOAD_1A, Some(hard));
+    let da = d * d;
+    let at_cap = low.p.iter().filter(|&&v| v >= hard).count();
+    let below: Vec<f64> = low
+        .p
+        .iter()
+        .cloned()
+        .filter(|&v| v > 0.0 && v < hard)
+        .collect();
+    assert!(below.len() <= 8, "{} cells below H", below.len());
+    let share = below[0];
+    assert!(below.iter().all(|&v| (v - share).abs() < 1e-9 * hard));
+    let goal = LOAD_1A / hard;
+    let area = (at_cap + below.len()) as f64 * da;
+    assert!(
+        at_cap as f64 * da <= goal && goal <= area,
+        "{at_cap} cells at H and {} below, against P/H = {} cells",
+        below.len(),
+        goal / da
+    );
+    // The contact is the cells of the smallest elastic gap h + uz: none
+    // out of contact stands lower than a capped cell.
+    let gap = |i: usize| h[i] + low.uz[i];
+    let capped_top = (0..h.len())
+        .filter(|&i| low.p[i] >= hard)
+        .map(gap)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let out_bottom = (0..h.len())
+        .filter(|&i| low.p[i] <= 0.0)
+        .map(gap)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        capped_top <= out_bottom,
+        "a cell out of contact at {out_bottom:e} m below a capped one at {capped_top:e} m"
+    );
+    assert!(low.report.load_error < 1e-12, "{:?}", low.report);
+    // The plastic penetration: the approach less the elastic surface's
+    // gap, positive on the capped cells.
+    let wmax = low.plastic.iter().cloned().fold(0.0, f64::max);
+    assert!(wmax > 0.0);
+}
+
+/// The axisymmetric reference: `n` annuli of width `w` (edges `j w`) with
+/// uniform pressure on each, the gap at the annuli's mid-radii.
+struct Rings {
+    w: f64,
+    zz: DMatrix<f64>,
+}
+
+/// The reference's solution: pressure per annulus and the approach.
+struct RingContact {
+    p: Vec<f64>,
+    approach: f64,
+}
+
+impl Rings {
+    fn new(n: usize, w: f64) -> Rings {
+        let g = E / (2.0 * (1.0 + NU));
+        let zz = DMatrix::from_fn(n, n, |i, j| {
+            let r = (i as f64 + 0.5) * w;
+            let outer = disc_pressure((j + 1) as f64 * w, r, g, NU).0;
+            let inner = if j == 0 {
+                0.0
+            } else {
+                disc_pressure(j as f64 * w, r, g, NU).0
+            };
+            outer - inner
+        });
+        Rings { w, zz }
+    }
+
+    fn area(&self, j: usize) -> f64 {
+        PI * self.w * self.w * ((2 * j + 1) as f64)
+    }
+
+    fn gap0(&self, i: usize) -> f64 {
+        let r = (i as f64 + 0.5) * self.w;
+        r * r / (2.0 * R)
+    }
+
+    /// The contact with the `zone` innermost annuli at the cap: the rest is
+    /// an elastic contact under the load they leave, solved by active sets
+    /// (one sign violation moved at a time, the worst first). `None` when
+    /// the zone alone carries the load.
+    fn with_zone(&self, load: f64, cap: f64, zone: usize) -> Option<RingContact> {
+        let n = self.zz.nrows();
+        let rest = load - (0..zone).map(|j| cap * self.area(j)).sum::<f64>();
+        if rest <= 0.0 {
+            return None;
+        }
+        let mut contact: Vec<bool> = (0..n)
+            .map(|i| i == zone || (i > zone && self.gap0(i) < hertz().0.powi(2) / (2.0 * R)))
+            .collect();
+        for _ in 0..4 * n {
+            let free: Vec<usize> = (0..n).filter(|&i| contact[i]).collect();
+            let m = free.len();
+            // Unknowns: p on the contact annuli and the approach δ.
+            let mut a = DMatrix::zeros(m + 1, m + 1);
+            let mut b = DVector::zeros(m + 1);
+            for (r, &i) in free.iter().enumerate() {
+                for (c, &j) in free.iter().enumerate() {
+                    a[(r, c)] = self.zz[(i, j)];
+                }
+                a[(r, m)] = -1.0;
+                let from_zone: f64 = (0..zone).map(|j| self.zz[(i, j)] * cap).sum();
+                b[r] = -self.gap0(i) - from_zone;
+            }
+            for (c, &j) in free.iter().enumerate() {
+                a[(m, c)] = self.area(j);
+            }
+            b[m] = rest;
+            let x = a.lu().solve(&b).expect("a regular system");
+            let approach = x[m];
+            let mut p = vec![0.0; n];
+            p[..zone].iter_mut().for_each(|v| *v = cap);
+            for (c, &j) in free.iter().enumerate() {
+                p[j] = x[c];
+            }
+            let gap = |i: usize| {
+                self.gap0(i) + (0..n).map(|j| self.zz[(i, j)] * p[j]).sum::<f64>() - approach
+            };
+            // The worst violation, a pressure below zero or a gap below
+            // zero scaled by the annulus's own compliance.
+            let mut worst = (0.0, usize::MAX);
+            for i in zone..n {
+                let v = if contact[i] {
+                    -p[i]
+                } else {
+                    -gap(i) / self.zz[(i, i)]
+                };
+                if v > worst.0 {
+                    worst = (v, i);
+                }
+            }
+            if worst.1 == usize::MAX {
+                return Some(RingContact { p, approach });
+            }
+            contact[worst.1] = !contact[worst.1];
+        }
+        panic!("the ring reference's contact set did not settle");
+    }
+
+    /// The elastic–perfectly plastic contact: the plastic zone is the
+    /// smallest disc of annuli at the cap that leaves every other annulus
+    /// below it. Checked: every annulus of the zone then reaches below the
+    /// indenter (its elastic gap is not positive, the plastic condition).
+    fn solve(&self, load: f64, cap: f64) -> RingContact {
+        // Bisection on the zone's size: below it some free annulus exceeds
+        // the cap, from it on none does.
+        let below_cap = |zone: usize| {
+            self.with_zone(load, cap, zone)
+                .filter(|s| s.p[zone..].iter().all(|&v| v <= cap))
+        };
+        // The largest zone that leaves the elastic part a load.
+        let mut hi = 0;
+        let mut zone_load = 0.0;
+        while hi + 1 < self.zz.nrows() && zone_load + cap * self.area(hi) < load {
+            zone_load += cap * self.area(hi);
+            hi += 1;
+        }
+        let mut lo = 0usize;
+        if below_cap(0).is_some() {
+            hi = 0;
+        }
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if below_cap(mid).is_some() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let zone = hi;
+        let sol = below_cap(zone).expect("a plastic zone that carries the load below the cap");
+        let n = self.zz.nrows();
+        for i in 0..zone {
+            let gap = self.gap0(i) + (0..n).map(|j| self.zz[(i, j)] * sol.p[j]).sum::<f64>()
+                - sol.approach;
+            assert!(
+                gap <= 1e-9 * sol.approach,
+                "zone annulus {i} of {zone} lifts off by {gap:e} m"
+            );
+        }
+        sol
+    }
+}
+
+/// The product's contact on `n x n` cells of `d` with cap `hardness`: contact
+/// and plastic radii (of their areas), the approach, and the pressure at a
+/// radius (bilinear in the cells along x and y, averaged).
+struct Grid3 {
+    contact_radius: f64,
+    plastic_radius: f64,
+    approach: f64,
+    p: Vec<f64>,
+    n: usize,
+    d: f64,
+}
+
+impl Grid3 {
+    fn solve(n: usize, d: f64, hardness: f64) -> Grid3 {
+        let (mut op, h) = sphere(n, d);
+        let sol = solve(&mut op, &h, LOAD_1A, Some(hardness));
+        let da = d * d;
+        let contact = sol.p.iter().filter(|&&v| v > 0.0).count() as f64 * da;
+        let plastic = sol.p.iter().filter(|&&v| v >= hardness).count() as f64 * da;
+        Grid3 {
+            contact_radius: (contact / PI).sqrt(),
+            plastic_radius: (plastic / PI).sqrt(),
+            approach: sol.approach,
+            p: sol.p,
+            n,
+            d,
+        }
+    }
+
+    /// The pressure at radius r along +x (cells are centred at (k + ½ − n/2) d).
+    fn p_at(&self, r: f64) -> f64 {
+        let n = self.n;
+        let t = r / self.d + 0.5 * n as f64 - 0.5;
+        let k = t.floor() as usize;
+        let f = t - k as f64;
+        // The two rows straddling y = 0, averaged.
+        let row = |iy: usize, ix: usize| self.p[iy * n + ix];
+        let (lo, hi) = (n / 2 - 1, n / 2);
+        let at = |ix: usize| 0.5 * (row(lo, ix) + row(hi, ix));
+        (1.0 - f) * at(k) + f * at(k + 1)
+    }
+}
+
+/// The ring reference's contact radius (the outer edge of the last loaded
+/// annulus, less the part of it the load leaves), its plastic radius (the
+/// capped annuli's area) and the pressure at a radius.
+fn ring_radii(rings: &Rings, sol: &RingContact, cap: f64) -> (f64, f64) {
+    let contact: f64 = (0..sol.p.len())
+        .filter(|&j| sol.p[j] > 0.0)
+        .map(|j| rings.area(j))
+        .sum();
+    let plastic: f64 = (0..sol.p.len())
+        .filter(|&j| sol.p[j] >= cap)
+        .map(|j| rings.area(j))
+        .sum();
+    ((contact / PI).sqrt(), (plastic / PI).sqrt())
+}
+
+fn ring_p_at(rings: &Rings, sol: &RingContact, r: f64) -> f64 {
+    let t = r / rings.w - 0.5;
+    let k = t.floor().max(0.0) as usize;
+    let f = (t - k as f64).clamp(0.0, 1.0);
+    let at = |j: usize| sol.p.get(j).copied().unwrap_or(0.0);
+    (1.0 - f) * at(k) + f * at(k + 1)
+}
+
+#[test]
+fn a_sphere_between_the_limits_agrees_with_the_ring_reference() {
+    // H = 0.8 p0, between Hertz's mean pressure (2/3 p0, below which
+    // nearly the whole contact yields) and its peak: the centre yields, the
+    // contact grows past Hertz's a. The reference on 400 rings over 2a is
+    // converged far below the 3-D grids' errors (its own change from 200 to
+    // 400 rings is printed).
+    let (a, p0) = hertz();
+    let cap = 0.8 * p0;
+    let coarse_rings = Rings::new(200, 2.0 * a / 200.0);
+    let rings = Rings::new(400, 2.0 * a / 400.0);
+    let reference = rings.solve(LOAD_1A, cap);
+    let (ra, rb) = ring_radii(&rings, &reference, cap);
+    let check = coarse_rings.solve(LOAD_1A, cap);
+    let (ca, cb) = ring_radii(&coarse_rings, &check, cap);
+    println!(
+        "rings 200 → 400: a {:.5} → {:.5}, b {:.5} → {:.5}, δ {:.6e} → {:.6e} (radii / Hertz a)",
+        ca / a,
+        ra / a,
+        cb / a,
+        rb / a,
+        check.approach,
+        reference.approach
+    );
+    assert!(
+        rb > 0.3 * a && rb < ra && ra > a,
+        "b/a {} a/aH {}",
+        rb / a,
+        ra / a
+    );
+    // The load of the reference.
+    let load: f64 = (0..reference.p.len())
+        .map(|j| reference.p[j] * rings.area(j))
+        .sum();
+    assert!((load - LOAD_1A).abs() < 1e-9 * LOAD_1A);
+
+    // The product on two grids of the same domain (3 a across), the finer
+    // closer on every measure.
+    let mut errors = Vec::new();
+    for (n, cells_per_a) in [(64, 16.0), (128, 32.0)] {
+        let d = a / cells_per_a;
+        let g = Grid3::solve(n, d, cap);
+        let e_a = (g.contact_radius - ra).abs() / a;
+        let e_b = (g.plastic_radius - rb).abs() / a;
+        let e_delta = (g.approach - reference.approach).abs() / reference.approach;
+        // The pressure profile on the radii inside the contact, away from
+        // the cell at its edge.
+        let e_p = (1..40)
+            .map(|k| k as f64 * 0.025 * ra)
+            .filter(|&r| r < ra - 2.0 * d)
+            .map(|r| (g.p_at(r) - ring_p_at(&rings, &reference, r)).abs())
+            .fold(0.0, f64::max)
+            / cap;
+        println!(
+            "{n}² ({cells_per_a} cells per a): a {:.5} (ref {:.5}), b {:.5} (ref {:.5}), δ rel. {e_delta:.2e}, max |Δp|/H {e_p:.3e}",
+            g.contact_radius / a,
+            ra / a,
+            g.plastic_radius / a,
+            rb / a
+        );
+        errors.push((e_a, e_b, e_delta, e_p));
+    }
+    let (coarse, fine) = (errors[0], errors[1]);
+    // The finer grid within a cell or two on the radii, 0.2 % on the
+    // approach, 5 % of H on the pressure; and no measure worse than the
+    // coarser grid's.
+    let cell = 1.0 / 32.0;
+    assert!(fine.0 < 1.5 * cell, "contact radius off by {} a", fine.0);
+    assert!(fine.1 < 2.0 * cell, "plastic radius off by {} a", fine.1);
+    assert!(fine.2 < 2e-3, "approach off by {}", fine.2);
+    assert!(fine.3 < 0.05, "pressure off by {} H", fine.3);
+    assert!(fine.2 < coarse.2, "approach: {} → {}", coarse.2, fine.2);
+    assert!(fine.3 < coarse.3, "pressure: {} → {}", coarse.3, fine.3);
+}
+
+#[test]
+fn unloading_keeps_the_dent_and_reloading_does_not_yield_again() {
+    // A normal load path P → P/10 → P at F = 0 on a surface whose hardness
+    // caps the Hertz peak: the first loading dents the surface; unloading
+    // is elastic (the pressure stays below H) and keeps the dent; reloading
+    // to P finds the dented surface and the same pressure, with no further
+    // plastic flow (elastic shakedown of a perfectly plastic surface under
+    // a repeated normal load).
+    let (_, p0) = hertz();
+    let cap = 0.7 * p0;
+    let mut spec = common::table_1a_fe(128, 3.0, false, 0.0);
+    spec.material = spec
+        .material
+        .with_limits(Limits {
+            hardness: Some(cap),
+            shear_limit: None,
+        })
+        .unwrap();
+    let mut cache = KernelCache::new();
+    let once = solve_case(&spec, &mut cache).unwrap();
+    let first = once.scalars.plastic.expect("a plastic zone");
+    assert!(first.plastic_area_m2 > 0.0 && first.penetration_max_m > 0.0);
+    let mut path = spec.clone();
+    path.history = Some(LoadHistory {
+        tangential_ratios: vec![0.0, 0.0, 0.0],
+        normal_forces_n: Some(vec![LOAD_1A, 0.1 * LOAD_1A, LOAD_1A]),
+        steps_per_segment: 2,
+        shifts_m: None,
+    });
+    let out = solve_case(&path, &mut cache).unwrap();
+    assert!(out.scalars.converged);
+    let after = out.scalars.plastic.expect("a plastic zone");
+    let rel = |x: f64, y: f64| (x - y).abs() / y;
+    assert!(
+        rel(after.penetration_max_m, first.penetration_max_m) < 1e-6,
+        "dent {} after the path against {} after the first loading",
+        after.penetration_max_m,
+        first.penetration_max_m
+    );
+    assert!(rel(after.dent_volume_m3, first.dent_volume_m3) < 1e-6);
+    let pmax = |p: &[f64]| p.iter().cloned().fold(0.0, f64::max);
+    let dp = (0..once.fields.p.len())
+        .map(|i| (once.fields.p[i] - out.fields.p[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        dp < 1e-6 * cap,
+        "reloaded pressure differs by {} H",
+        dp / cap
+    );
+    assert!((pmax(&out.fields.p) - cap).abs() < 1e-9 * cap);
+    // The path did pass through the unloaded state.
+    let history = out.scalars.history.expect("a path");
+    let unloaded = &history.steps[history.turning_steps[1]];
+    assert!((unloaded.normal_force_n - 0.1 * LOAD_1A).abs() < 1e-9 * LOAD_1A);
+}
+
+#[test]
+fn a_shear_limit_caps_the_sliding_force_at_the_integral_of_min_mu_p_tau() {
+    // Gross sliding under an imposed shift, coupling off (the pressure
+    // stays Hertz's): every contact cell slides at its bound min(μp, τ_c),
+    // so F = ∫ min(μ p_H(r), τ_c) dA, in closed form with the radius
+    // r₁ = a √(1 − (τ_c/μp0)²) inside which the shear limit binds:
+    // F = τ_c π r₁² + (2π/3) μ p0 a² (1 − r₁²/a²)^{3/2}.
+    let (a, p0) = hertz();
+    let mu = common::MU_1A;
+    let tau = 0.5 * mu * p0;
+    let mut spec = common::table_1a_fe(128, 2.0, false, 0.0);
+    spec.material = spec
+        .material
+        .with_limits(Limits {
+            hardness: None,
+            shear_limit: Some(tau),
+        })
+        .unwrap();
+    // Three times Mindlin's δ* = 3μP(2 − ν)/(16 a G): the contact slides.
+    let g = E / (2.0 * (1.0 + NU));
+    let delta_star = 3.0 * mu * LOAD_1A * (2.0 - NU) / (16.0 * a * g);
+    spec.history = Some(LoadHistory {
+        tangential_ratios: Vec::new(),
+        normal_forces_n: None,
+        steps_per_segment: 4,
+        shifts_m: Some(vec![0.0, 3.0 * delta_star]),
+    });
+    let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
+    assert!(out.scalars.converged);
+    let f = out.scalars.tangential_force_n[0];
+    let r1 = a * (1.0 - (tau / (mu * p0)).powi(2)).sqrt();
+    let closed =
+        tau * PI * r1 * r1 + 2.0 * PI / 3.0 * mu * p0 * a * a * (1.0 - (r1 / a).powi(2)).powf(1.5);
+    let da = spec.grid.cell_area();
+    let discrete: f64 = out.fields.p.iter().map(|&p| (mu * p).min(tau)).sum::<f64>() * da;
+    let qmax = (0..out.fields.p.len())
+        .map(|i| out.fields.qx[i].hypot(out.fields.qy[i]))
+        .fold(0.0, f64::max);
+    println!(
+        "F {f:.6e} N, Σ min(μp, τc) dA {discrete:.6e} N, closed form {closed:.6e} N ({:+.2e}); μP {:.4e} N; max |q| / τc {:.9}",
+        f / closed - 1.0,
+        mu * LOAD_1A,
+        qmax / tau
+    );
+    assert!(
+        qmax <= tau * (1.0 + 1e-12),
+        "max |q| = {qmax} above τc = {tau}"
+    );
+    assert!((f / discrete - 1.0).abs() < 1e-5, "F against Σ min(μp, τc)");
+    assert!((f / closed - 1.0).abs() < 1e-3, "F against the closed form");
+    assert!(f < 0.9 * mu * LOAD_1A, "the limit must bind");
+}
