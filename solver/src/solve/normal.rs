@@ -511,7 +511,7 @@ const ZONE_START: f64 = 1e-6;
 
 /// Tolerance of a capped solve's elastic solves while its plastic zone
 /// moves.
-const SETTLING_TOLERANCE: f64 = 1e-4;
+const SETTLING_TOLERANCE: f64 = 1e-3;
 
 /// The separation that keeps a cell of the plastic zone out of the elastic
 /// contact around it, m (gaps are micrometres; a cell so far is never
@@ -548,8 +548,10 @@ fn plastic_zone(
         .collect();
     let mut report = NormalReport::default();
     let (mut p_zone, mut u_zone, mut h_in) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
-    // While the zone moves, its elastic solves stop early; once it holds,
-    // one solve to the tolerance decides.
+    // While the zone moves, its elastic solves stop early (at 1e-4 the
+    // Table 1(c)'s circle-B at 512² of 30 µm took 125 normal iterations, at 1e-3
+    // 109; solving a warm zone to the tolerance from its first update,
+    // 199); once the zone holds, one solve to the tolerance decides.
     let mut settling = true;
     for _ in 0..MAX_ZONE_UPDATES {
         let mut carried: f64 = (0..len).filter(|&i| zone[i]).map(|i| cap[i]).sum();
