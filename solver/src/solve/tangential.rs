@@ -310,7 +310,7 @@ fn on_grid_taking(
     if fnorm >= mu * normal {
         return Err(SolverError::GrossSliding {
             detail: format!(
-                "tangential force {fnorm:.6e} N reaches the friction limit μP = {:.6e} N",
+                "tangential force {fnorm:.6e} N reaches the friction limit Σ μp ΔA = {:.6e} N (μP; with a shear limit, Σ min(μp, τ_c) ΔA)",
                 mu * normal
             ),
         });
