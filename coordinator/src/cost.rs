@@ -31,9 +31,18 @@ pub const CASE_EXPONENT: f64 = 2.35;
 /// (commit 19ee3eb; before it the monotonic solves were slower, 0.55×).
 const INCREMENT_COST: f64 = 0.6;
 
+/// A case on a surface with a hardness costs about 2.5 elastic ones: the
+/// paper's Table 1(c) surfaces at 512² took 2.0–2.1× the elastic sweep's
+/// time with H = 0.9 GPa and 3.2–3.4× with 0.5 GPa (docs/performance.md,
+/// "A capped surface"); a contact that does not yield costs what it did.
+const CAPPED_COST: f64 = 2.5;
+
 /// Expected seconds of one case on one worker.
 pub fn case_seconds(spec: &CaseSpec) -> f64 {
-    let one = seconds_at_384(spec) * (spec.grid.n as f64 / 384.0).powf(CASE_EXPONENT);
+    let mut one = seconds_at_384(spec) * (spec.grid.n as f64 / 384.0).powf(CASE_EXPONENT);
+    if spec.limits().hardness.is_some() {
+        one *= CAPPED_COST;
+    }
     match &spec.history {
         Some(h) => {
             let segments = h.turning_points(&spec.load).len().saturating_sub(1);
