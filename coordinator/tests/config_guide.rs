@@ -91,6 +91,11 @@ fn accepted_keys() -> BTreeSet<String> {
             displacement_um: Some(1.0),
             cycles: 2,
         }),
+        wear: Some(coordinator::config::WearCfg {
+            law: "archard".into(),
+            k_mm3_per_nm: Some(1e-5),
+            alpha_mm3_per_j: Some(1e-5),
+        }),
     });
     c.stress = Some(coordinator::config::StressCfg {
         depths_um: vec![0.0, 10.0],

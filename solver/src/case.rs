@@ -104,5 +104,6 @@ fn solve_history_case(
     )?;
     out.scalars.converged &= converged;
     out.turning = turning;
+    out.fields.wear = solved.worn;
     Ok(out)
 }

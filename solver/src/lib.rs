@@ -110,7 +110,8 @@ pub use model::radii::{
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
 pub use model::spec::{
-    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, MAX_GRID_POINTS, MAX_HISTORY_STEPS,
+    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, WearLaw, MAX_GRID_POINTS,
+    MAX_HISTORY_STEPS,
 };
 pub use model::surface::{
     Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER, RESOLVED_CELLS_PER_PITCH,

@@ -157,6 +157,7 @@ fn a_fretting_history_meets_mindlin_deresiewicz() {
             normal_forces_n: None,
             steps_per_segment: 20,
             shifts_m: None,
+            wear: None,
         });
         with_method(s, method)
     };

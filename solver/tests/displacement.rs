@@ -96,6 +96,7 @@ fn fretting(amplitude: f64, cycles: usize, steps: usize) -> solver::CaseOutput {
         normal_forces_n: None,
         steps_per_segment: steps,
         shifts_m: Some(shifts),
+        wear: None,
     });
     solver::solve_case(&spec, &mut KernelCache::new()).expect("the path solves")
 }

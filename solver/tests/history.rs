@@ -72,6 +72,7 @@ fn fretting(n: usize, spacing_um: f64, amplitude: f64, cycles: usize, steps: usi
             normal_forces_n: None,
             steps_per_segment: steps,
             shifts_m: None,
+            wear: None,
         }),
         ..table_1a_fe(n, spacing_um, false, amplitude)
     }
@@ -202,6 +203,7 @@ fn proportional_loading_below_mu_leaves_no_slip() {
         normal_forces_n: Some(vec![P / 8.0, P]),
         steps_per_segment: 20,
         shifts_m: None,
+        wear: None,
     });
     let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
     let h = out.scalars.history.as_ref().unwrap();
@@ -269,6 +271,7 @@ fn quick_fretting(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
             normal_forces_n: None,
             steps_per_segment: 10,
             shifts_m: None,
+            wear: None,
         }),
         ..common::quick_1c(material, surface, angle_deg)
     }

@@ -431,6 +431,7 @@ fn unloading_keeps_the_dent_and_reloading_does_not_yield_again() {
         normal_forces_n: Some(vec![LOAD_1A, 0.1 * LOAD_1A, LOAD_1A]),
         steps_per_segment: 2,
         shifts_m: None,
+        wear: None,
     });
     let out = solve_case(&path, &mut cache).unwrap();
     assert!(out.scalars.converged);
@@ -485,6 +486,7 @@ fn a_shear_limit_caps_the_sliding_force_at_the_integral_of_min_mu_p_tau() {
         normal_forces_n: None,
         steps_per_segment: 4,
         shifts_m: Some(vec![0.0, 3.0 * delta_star]),
+        wear: None,
     });
     let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
     assert!(out.scalars.converged);

@@ -444,6 +444,7 @@ fn solver_history(
         normal_forces_n: Some(vec![first, last]),
         steps_per_segment: steps,
         shifts_m: None,
+        wear: None,
     });
     solve_case(&spec, &mut KernelCache::new()).expect("the history solves")
 }

@@ -513,6 +513,7 @@ fn a_load_history_keeps_the_tractions_of_its_turning_points() {
             normal_forces_n: None,
             steps_per_segment: 3,
             shifts_m: None,
+            wear: None,
         }),
         indenter: None,
     };

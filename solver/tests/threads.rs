@@ -110,6 +110,7 @@ fn uncoupled_and_coupled_load_histories_are_bit_identical_on_1_2_and_3_threads()
                 normal_forces_n: None,
                 steps_per_segment: steps,
                 shifts_m: None,
+                wear: None,
             }),
             ..table_1a_fe(n, spacing_um, coupling, 0.6)
         };
@@ -137,6 +138,7 @@ fn the_active_set_iteration_is_bit_identical_on_1_2_and_3_threads() {
                 normal_forces_n: None,
                 steps_per_segment: 4,
                 shifts_m: None,
+                wear: None,
             });
         }
         let one = same_on_1_2_and_3_threads(&spec, true);

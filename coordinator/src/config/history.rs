@@ -4,7 +4,7 @@
 use super::Config;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
-use solver::LoadHistory;
+use solver::{LoadHistory, WearLaw};
 
 /// `[history]`: a load path applied to every case (fretting loops,
 /// proportional loading), PHYSICS.md §5b. Either the turning points
@@ -29,6 +29,60 @@ pub struct HistoryCfg {
     /// Shorthand: 0 → +A → −A → +A … with `cycles` full cycles.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fretting: Option<FrettingCfg>,
+    /// The substrate's wear along the path (issue #49).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wear: Option<WearCfg>,
+}
+
+/// `history.wear`: a local wear law, its coefficient in the unit rigs
+/// report.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WearCfg {
+    /// `archard` (dh = k p |ds|) or `energy` (dh = α |q · ds|).
+    pub law: String,
+    /// Archard's k, mm³/(N·m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_mm3_per_nm: Option<f64>,
+    /// The energy law's α, mm³/J.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_mm3_per_j: Option<f64>,
+}
+
+impl WearCfg {
+    /// The solver's law (SI: 1 mm³/(N·m) = 1 mm³/J = 1e-9 m³/J).
+    fn law(&self) -> Result<WearLaw> {
+        let coefficient = |key: &str, v: Option<f64>| -> Result<f64> {
+            let v = v.ok_or_else(|| {
+                anyhow::anyhow!("history.wear.{key}: required with law = \"{}\"", self.law)
+            })?;
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("history.wear.{key} = {v}: must be finite and ≥ 0");
+            }
+            Ok(v * 1e-9)
+        };
+        match self.law.as_str() {
+            "archard" => {
+                if self.alpha_mm3_per_j.is_some() {
+                    bail!("history.wear.alpha_mm3_per_j: belongs to law = \"energy\"; Archard's law takes k_mm3_per_nm");
+                }
+                Ok(WearLaw::Archard {
+                    k: coefficient("k_mm3_per_nm", self.k_mm3_per_nm)?,
+                })
+            }
+            "energy" => {
+                if self.k_mm3_per_nm.is_some() {
+                    bail!("history.wear.k_mm3_per_nm: belongs to law = \"archard\"; the energy law takes alpha_mm3_per_j");
+                }
+                Ok(WearLaw::Energy {
+                    alpha: coefficient("alpha_mm3_per_j", self.alpha_mm3_per_j)?,
+                })
+            }
+            other => bail!(
+                "history.wear.law = \"{other}\": must be \"archard\" (dh = k p |ds|) or \"energy\" (dh = α |q·ds|)"
+            ),
+        }
+    }
 }
 
 /// `history.fretting`: a fretting loop of force amplitude A =
@@ -69,6 +123,13 @@ impl HistoryCfg {
     /// case's entry of `sweep.amplitudes_um`) is the displacement amplitude
     /// of `fretting = { cycles = N }`; `None` outside a map.
     pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
+        let mut path = self.path_at(amplitude_um)?;
+        path.wear = self.wear.as_ref().map(WearCfg::law).transpose()?;
+        Ok(path)
+    }
+
+    /// The turning points of [`HistoryCfg::load_history_at`], without wear.
+    fn path_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
         let given = [
             self.tangential_ratios.is_some(),
             self.tangential_um.is_some(),
@@ -95,6 +156,7 @@ impl HistoryCfg {
                 normal_forces_n: None,
                 steps_per_segment: self.steps_per_segment,
                 shifts_m: Some(shifts),
+                wear: None,
             });
         }
         if let Some(d) = &self.tangential_um {
@@ -103,6 +165,7 @@ impl HistoryCfg {
                 normal_forces_n: self.normal_n.clone(),
                 steps_per_segment: self.steps_per_segment,
                 shifts_m: Some(d.iter().map(|v| v * 1e-6).collect()),
+                wear: None,
             });
         }
         if let Some(f) = &self.fretting {
@@ -119,6 +182,7 @@ impl HistoryCfg {
                     normal_forces_n: None,
                     steps_per_segment: self.steps_per_segment,
                     shifts_m: Some(shifts),
+                    wear: None,
                 });
             }
         }
@@ -142,6 +206,7 @@ impl HistoryCfg {
             normal_forces_n: self.normal_n.clone(),
             steps_per_segment: self.steps_per_segment,
             shifts_m: None,
+            wear: None,
         })
     }
 

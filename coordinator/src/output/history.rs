@@ -15,12 +15,22 @@ use super::plot::{self, err, Area, Figure, Frame, PALETTE};
 /// Header of `history.csv`.
 pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged";
 
+/// The column `history.csv` gains on a path with a wear law: the volume
+/// worn from the start of the path to the increment (a path without one
+/// has the header above, to the byte).
+pub const HISTORY_WEAR_COLUMN: &str = "worn_volume_m3";
+
 /// Text of `history.csv`.
 pub fn history_csv(h: &HistoryOutput) -> String {
+    let wear = h.worn_volume_m3.is_some();
     let mut out = String::from(HISTORY_HEADER);
+    if wear {
+        out.push(',');
+        out.push_str(HISTORY_WEAR_COLUMN);
+    }
     out.push('\n');
     for r in &h.steps {
-        let _ = writeln!(
+        let _ = write!(
             out,
             "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.step,
@@ -37,6 +47,10 @@ pub fn history_csv(h: &HistoryOutput) -> String {
             r.segment,
             r.converged,
         );
+        if wear {
+            let _ = write!(out, ",{}", fmt_f64(r.worn_volume_m3));
+        }
+        out.push('\n');
     }
     out
 }

@@ -260,6 +260,7 @@ mod tests {
                 normal_forces_n: None,
                 steps_per_segment: 2,
                 shifts_m: None,
+                wear: None,
             }),
             ..small_case()
         };

@@ -137,6 +137,55 @@ pub struct LoadHistory {
     /// the contact may slide as a whole (gross slip).
     #[serde(default)]
     pub shifts_m: Option<Vec<f64>>,
+    /// The wear of the substrate along the path (PHYSICS.md §5d): each
+    /// increment's worn depth joins the separation the next one sees.
+    /// `None`: no wear.
+    #[serde(default)]
+    pub wear: Option<WearLaw>,
+}
+
+/// A local wear law (PHYSICS.md §5d): the substrate's worn depth per
+/// increment of slip `ds` of a cell (the rigid shift's increment less the
+/// surface's elastic displacement increment).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum WearLaw {
+    /// Archard: `dh = k p |ds|`, `k` in m³/(N·m) (= 1/Pa).
+    Archard {
+        /// Wear coefficient k, m³/(N·m).
+        k: f64,
+    },
+    /// Fouvry's dissipated-energy law: `dh = α |q · ds|`, `α` in m³/J
+    /// (= 1/Pa); the worn volume is α times the dissipated energy.
+    Energy {
+        /// Energy wear coefficient α, m³/J.
+        alpha: f64,
+    },
+}
+
+impl WearLaw {
+    /// The worn depth of a cell over an increment, m: pressure `p` and
+    /// tractions `q` (each the mean of the increment's two ends, the
+    /// trapezoidal rule of the dissipation) and slip increment `ds`.
+    pub fn depth(&self, p: f64, q: [f64; 2], ds: [f64; 2]) -> f64 {
+        match *self {
+            WearLaw::Archard { k } => k * p.max(0.0) * ds[0].hypot(ds[1]),
+            WearLaw::Energy { alpha } => alpha * (q[0] * ds[0] + q[1] * ds[1]).abs(),
+        }
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        let (name, v) = match *self {
+            WearLaw::Archard { k } => ("history.wear.k", k),
+            WearLaw::Energy { alpha } => ("history.wear.alpha", alpha),
+        };
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(SolverError::invalid(
+                name,
+                format!("the wear coefficient must be finite and ≥ 0, got {v}"),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl LoadHistory {
@@ -179,6 +228,9 @@ impl LoadHistory {
 
     /// Rejects impossible paths, naming `history.<key>[index]`.
     pub fn validate(&self) -> Result<(), SolverError> {
+        if let Some(w) = &self.wear {
+            w.validate()?;
+        }
         let n = self.count();
         let key = if self.displacement_controlled() {
             "history.shifts_m"

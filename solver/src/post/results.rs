@@ -148,15 +148,21 @@ pub struct Fields {
     /// Permanent plastic penetration (the dent), m; empty on an elastic
     /// surface. Not one of [`Fields::named`]: sweeps do not carry it.
     pub plastic: Vec<f64>,
+    /// Worn depth over a load path with a wear law, m; empty without one.
+    /// Not one of [`Fields::named`] either.
+    pub wear: Vec<f64>,
 }
 
 impl Fields {
     /// Every field the case has with its file name: [`Fields::named`],
-    /// then `plastic` on a surface with a hardness.
+    /// then `plastic` on a surface with a hardness and `wear` after a path
+    /// with a wear law.
     pub fn present(&self) -> Vec<(&'static str, &Vec<f64>)> {
         let mut all = self.named().to_vec();
-        if !self.plastic.is_empty() {
-            all.push(("plastic", &self.plastic));
+        for (name, v) in [("plastic", &self.plastic), ("wear", &self.wear)] {
+            if !v.is_empty() {
+                all.push((name, v));
+            }
         }
         all
     }
@@ -471,6 +477,7 @@ pub(crate) fn reduce(
         uy,
         uz,
         plastic,
+        wear: Vec::new(),
     };
     Ok(CaseOutput {
         scalars: s,

@@ -43,6 +43,10 @@ pub struct HistoryStep {
     pub stick_radius_m: f64,
     /// Energy dissipated in this increment ([`DISSIPATION_DEFINITION`]), J.
     pub dissipated_j: f64,
+    /// Worn volume from the start of the path to this increment, m³ (0
+    /// without a wear law).
+    #[serde(default)]
+    pub worn_volume_m3: f64,
     /// The increment's solves converged.
     pub converged: bool,
 }
@@ -88,6 +92,15 @@ pub struct HistoryOutput {
     /// `partial`, `gross`, or `mixed` when it changes between cycles.
     #[serde(default)]
     pub regime: Option<String>,
+    /// With a wear law: the volume worn over the whole path, m³.
+    #[serde(default)]
+    pub worn_volume_m3: Option<f64>,
+    /// With a wear law: the volume worn over the last full cycle, m³.
+    #[serde(default)]
+    pub worn_volume_per_cycle_m3: Option<f64>,
+    /// With a wear law: the largest worn depth, m.
+    #[serde(default)]
+    pub worn_depth_max_m: Option<f64>,
 }
 
 /// How [`HistoryOutput::regime`] is decided.
@@ -128,6 +141,8 @@ pub(crate) struct HistoryState {
     pub output: HistoryOutput,
     /// The states at the turning points, the start first.
     pub turning: Vec<TurningState>,
+    /// The worn depth per cell over the path, m (empty without wear).
+    pub worn: Vec<f64>,
 }
 
 /// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
@@ -181,9 +196,27 @@ pub(crate) fn solve_history(
     // On a surface with a hardness, the plastic penetration is permanent:
     // every increment's adds to the dent, and the separation the next
     // increment sees is the initial one plus the dent (unloading leaves it).
+    // Worn depth likewise, with a wear law (the surface recedes).
     let mut dent = normal0.plastic.clone();
-    let mut dented: Option<Vec<f64>> =
-        (!dent.is_empty()).then(|| h0.iter().zip(&dent).map(|(h, d)| h + d).collect());
+    let wear = history.wear;
+    let mut worn: Vec<f64> = if wear.is_some() {
+        vec![0.0; len]
+    } else {
+        Vec::new()
+    };
+    let (mut worn_volume, mut worn_max) = (0.0, 0.0_f64);
+    let separation = |dent: &[f64], worn: &[f64]| -> Option<Vec<f64>> {
+        if dent.is_empty() && worn.is_empty() {
+            return None;
+        }
+        let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
+        Some(
+            (0..len)
+                .map(|i| h0[i] + at(dent, i) + at(worn, i))
+                .collect(),
+        )
+    };
+    let mut dented = separation(&dent, &worn);
     let mut last = ContactState {
         p: normal0.p,
         approach: normal0.approach,
@@ -339,6 +372,21 @@ pub(crate) fn solve_history(
                     work += mx * (shift[0] - (vx[i] - ux[i])) + my * (shift[1] - (vy[i] - uy[i]));
                 }
             }
+            // The increment's wear, with the dissipation's slip and means.
+            if let Some(law) = wear {
+                for i in 0..len {
+                    let pm = 0.5 * (last.p[i] + state.p[i]);
+                    if pm <= 0.0 {
+                        continue;
+                    }
+                    let q = [0.5 * (qx0[i] + qx1[i]), 0.5 * (qy0[i] + qy1[i])];
+                    let ds = [shift[0] - (vx[i] - ux[i]), shift[1] - (vy[i] - uy[i])];
+                    let dh = law.depth(pm, q, ds);
+                    worn[i] += dh;
+                    worn_volume += dh * da;
+                    worn_max = worn_max.max(worn[i]);
+                }
+            }
             delta_t = [delta_t[0] + shift[0], delta_t[1] + shift[1]];
             last_increment = shift[0].hypot(shift[1]);
             delta_t_max = delta_t_max.max(delta_t[0].hypot(delta_t[1]));
@@ -349,7 +397,7 @@ pub(crate) fn solve_history(
             normal_iterations += state.normal_iterations;
             tangential_iterations += state.tangential_iterations;
             coupling_iterations += state.coupling_iterations;
-            let r = row(
+            let mut r = row(
                 spec,
                 terrain,
                 &state,
@@ -361,6 +409,7 @@ pub(crate) fn solve_history(
                     converged: step_converged,
                 },
             );
+            r.worn_volume_m3 = worn_volume;
             if !displacement_control {
                 let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
                 force_error_max = force_error_max.max(ferr);
@@ -371,7 +420,9 @@ pub(crate) fn solve_history(
                 dent.iter_mut()
                     .zip(&state.plastic)
                     .for_each(|(d, w)| *d += w);
-                dented = Some(h0.iter().zip(&dent).map(|(h, d)| h + d).collect());
+            }
+            if !state.plastic.is_empty() || wear.is_some() {
+                dented = separation(&dent, &worn);
             }
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
@@ -387,12 +438,19 @@ pub(crate) fn solve_history(
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
-    let output = reduce_history(dir, rows, &points, turning_steps, force_error_max);
+    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max);
+    if wear.is_some() {
+        output.worn_volume_m3 = Some(worn_volume);
+        output.worn_depth_max_m = Some(worn_max);
+    } else {
+        output.worn_volume_per_cycle_m3 = None;
+    }
     Ok(HistoryState {
         last,
         converged,
         output,
         turning,
+        worn,
     })
 }
 
@@ -436,6 +494,7 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
         stick_area_m2: count(&stick),
         stick_radius_m: stick_radius,
         dissipated_j: sums.dissipated,
+        worn_volume_m3: 0.0,
         converged: sums.converged,
     }
 }
@@ -532,6 +591,7 @@ fn reduce_history(
         regimes.push(gross);
         j = (k >= 2).then(|| Some(k - 2));
     }
+    let worn_per_cycle = cycle.map(|(s0, s1)| steps[s1].worn_volume_m3 - steps[s0].worn_volume_m3);
     let regime = (!regimes.is_empty()).then(|| {
         if regimes.iter().all(|&g| g) {
             "gross".to_string()
@@ -555,5 +615,8 @@ fn reduce_history(
         shift_amplitude_m,
         energy_ratio,
         regime,
+        worn_volume_m3: None,
+        worn_volume_per_cycle_m3: worn_per_cycle,
+        worn_depth_max_m: None,
     }
 }
