@@ -10,9 +10,8 @@ mod common;
 use common::axisym::disc_pressure;
 use common::LOAD_1A;
 use nalgebra::{DMatrix, DVector};
-use solver::influence::isotropic_cell;
 use solver::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
-use solver::{solve_case, Grid, KernelCache, Limits, LoadHistory, Operator};
+use solver::{solve_case, KernelCache, Limits, LoadHistory, Operator};
 use std::f64::consts::PI;
 
 /// Table 1a: Fe under an 18 mm sphere.
@@ -23,20 +22,6 @@ const R: f64 = 18.0e-3;
 fn hertz() -> (f64, f64) {
     let a = (3.0 * LOAD_1A * R / (4.0 * E / (1.0 - NU * NU))).cbrt();
     (a, 3.0 * LOAD_1A / (2.0 * PI * a * a))
-}
-
-/// The operator and the sphere's separation on `n x n` cells of `d`.
-fn sphere(n: usize, d: f64) -> (Operator, Vec<f64>) {
-    let grid = Grid { n, dx: d, dy: d };
-    let g = E / (2.0 * (1.0 + NU));
-    let op = Operator::build(grid, |x, y| isotropic_cell(g, NU, x, y, d, d));
-    let h = (0..grid.len())
-        .map(|i| {
-            let (x, y) = (grid.x(i % n), grid.y(i / n));
-            (x * x + y * y) / (2.0 * R)
-        })
-        .collect();
-    (op, h)
 }
 
 fn solve(op: &mut Operator, h: &[f64], load: f64, hardness: Option<f64>) -> NormalSolution {
@@ -58,7 +43,7 @@ fn solve(op: &mut Operator, h: &[f64], load: f64, hardness: Option<f64>) -> Norm
 fn a_cap_above_the_elastic_peak_changes_nothing_and_a_low_cap_spreads_p_equal_h() {
     let (a, p0) = hertz();
     let d = a / 20.0;
-    let (mut op, h) = sphere(96, d);
+    let (mut op, h) = common::fe_sphere(96, d);
     let elastic = solve(&mut op, &h, LOAD_1A, None);
     assert!(elastic.plastic.is_empty());
     let pmax = elastic.p.iter().cloned().fold(0.0, f64::max);
@@ -276,7 +261,7 @@ struct Grid3 {
 
 impl Grid3 {
     fn solve(n: usize, d: f64, hardness: f64) -> Grid3 {
-        let (mut op, h) = sphere(n, d);
+        let (mut op, h) = common::fe_sphere(n, d);
         let sol = solve(&mut op, &h, LOAD_1A, Some(hardness));
         let da = d * d;
         let contact = sol.p.iter().filter(|&&v| v > 0.0).count() as f64 * da;

@@ -94,19 +94,26 @@ pub const LOAD_1A: f64 = 20.0;
 /// See [`LOAD_1A`].
 pub const MU_1A: f64 = 0.28571;
 
-/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm at Table 1a's load:
-/// the Hertz pressure on an `n x n` grid of cell `d`, and the operator.
-pub fn hertz_fe(n: usize, d: f64) -> (Operator, Vec<f64>) {
+/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm: the operator of an
+/// `n x n` grid of cell `d` and the sphere's separation on it.
+pub fn fe_sphere(n: usize, d: f64) -> (Operator, Vec<f64>) {
     let grid = Grid { n, dx: d, dy: d };
     let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
     let g = e / (2.0 * (1.0 + nu));
-    let mut op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
+    let op = Operator::build(grid, |x, y| isotropic_cell(g, nu, x, y, d, d));
     let h: Vec<f64> = (0..grid.len())
         .map(|i| {
             let (x, y) = (grid.x(i % n), grid.y(i / n));
             (x * x + y * y) / (2.0 * r)
         })
         .collect();
+    (op, h)
+}
+
+/// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm at Table 1a's load:
+/// the Hertz pressure on an `n x n` grid of cell `d`, and the operator.
+pub fn hertz_fe(n: usize, d: f64) -> (Operator, Vec<f64>) {
+    let (mut op, h) = fe_sphere(n, d);
     let mut cache = NormalCache::new(&mut op);
     let p = solve_normal(&mut op, &mut cache, &NormalProblem::new(&h, LOAD_1A))
         .unwrap()
