@@ -77,8 +77,8 @@ class Result:
         the columns of the CLI's ``history.csv`` (``step``,
         ``normal_force_n``, ``fx_n``, ``fy_n``, ``delta_x_m``, ``delta_y_m``,
         ``delta_z_m``, ``contact_area_m2``, ``stick_area_m2``,
-        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``).
-        The per-cycle energy, reversal stiffness and residual shift are in
+        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``, and
+        ``worn_volume_m3`` with a wear law). The per-cycle energy, reversal stiffness and residual shift are in
         ``scalars`` as in ``case.json``."""
         h = self.scalars.get("history")
         if h is None:
@@ -90,7 +90,7 @@ class Result:
         def col(get, dtype=np.float64):
             return np.array([get(r) for r in steps], dtype=dtype)
 
-        return {
+        table = {
             "step": col(lambda r: r["step"], np.int64),
             "normal_force_n": col(lambda r: r["normal_force_n"]),
             "fx_n": col(lambda r: r["force_n"][0]),
@@ -105,6 +105,10 @@ class Result:
             "segment": col(lambda r: r["segment"], np.int64),
             "converged": col(lambda r: r["converged"], bool),
         }
+        # With a wear law, as the CLI's history.csv: the volume worn so far.
+        if h.get("worn_volume_m3") is not None:
+            table["worn_volume_m3"] = col(lambda r: r["worn_volume_m3"])
+        return table
 
     def __repr__(self):
         s = self.scalars

@@ -204,6 +204,30 @@ def test_a_fretting_history_equals_the_cli_table_bit_for_bit(tmp_path, cli_solve
     assert mpcontact.solve(mpcontact.Config.from_toml(plain)).history() is None
 
 
+def test_wear_along_a_fretting_path_equals_the_cli(tmp_path, cli_solve):
+    # Archard wear over one cycle: the table with its worn-volume column,
+    # the worn depth and the totals the same bits as the CLI's.
+    path = tmp_path / "wear.toml"
+    path.write_text(
+        mindlin_text(ratio=0.6)
+        + "\n[history]\nfretting = { amplitude_ratio = 0.6, cycles = 1 }\nsteps_per_segment = 4\n"
+        + 'wear = { law = "archard", k_mm3_per_nm = 1e-5 }\n'
+    )
+    case_json, cli_dir = cli_solve(path)
+    res = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert_same_as_cli(res, case_json, cli_dir)
+    h = res.history()
+    lines = (cli_dir / "history.csv").read_text().splitlines()
+    assert list(h) == lines[0].split(",")
+    worn = np.array([line.split(",")[-1] for line in lines[1:]], dtype=np.float64)
+    assert worn.tobytes() == h["worn_volume_m3"].tobytes()
+    depth = res.fields["wear"]
+    assert depth.tobytes() == np.load(cli_dir / "wear.npy").tobytes()
+    total = res.scalars["history"]["worn_volume_m3"]
+    assert total == worn[-1] > 0.0
+    assert depth.sum() * (4e-6) ** 2 == pytest.approx(total, rel=1e-12)
+
+
 def test_an_elastic_ball_from_python_equals_the_cli_and_softens_the_contact(
     tmp_path, cli_solve
 ):
