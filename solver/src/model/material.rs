@@ -202,6 +202,17 @@ pub struct Limits {
     pub shear_limit: Option<f64>,
 }
 
+/// A surface limit on each of `len` cells: `limit` on the covered part of
+/// the cell, `limit × cover` (a cell's traction is its mean over the whole
+/// cell and sits on the covered part, #34), `limit` where whole. The one
+/// place a hardness or a shear limit meets the cut cells.
+pub fn limit_per_cell(limit: f64, cover: Option<&[f64]>, len: usize) -> Vec<f64> {
+    match cover {
+        Some(cover) => cover.iter().map(|c| limit * c).collect(),
+        None => vec![limit; len],
+    }
+}
+
 impl Limits {
     /// The limits of the interface between two bodies: the smaller of each
     /// (the softer surface yields first).

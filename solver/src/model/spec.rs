@@ -413,9 +413,10 @@ impl CaseSpec {
         let mu = self.load.friction;
         match self.limits().shear_limit {
             Some(tau) if mu > 0.0 => std::borrow::Cow::Owned(
-                p.iter()
-                    .enumerate()
-                    .map(|(i, &v)| v.min(tau * cover.map_or(1.0, |c| c[i]) / mu))
+                crate::model::material::limit_per_cell(tau, cover, p.len())
+                    .iter()
+                    .zip(p)
+                    .map(|(t, &v)| v.min(t / mu))
                     .collect(),
             ),
             _ => std::borrow::Cow::Borrowed(p),

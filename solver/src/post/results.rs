@@ -414,11 +414,9 @@ pub(crate) fn reduce(
         plastic: None,
     };
     if let Some(hardness) = spec.limits().hardness {
-        // The cells at the cap, as the normal solver sets it (hardness
-        // times cover, to the bit).
-        let capped: Vec<bool> = (0..len)
-            .map(|i| p[i] > 0.0 && p[i] >= hardness * cover.map_or(1.0, |c| c[i]))
-            .collect();
+        // The cells at the cap, the normal solver's to the bit.
+        let caps = crate::model::material::limit_per_cell(hardness, cover, len);
+        let capped: Vec<bool> = (0..len).map(|i| p[i] > 0.0 && p[i] >= caps[i]).collect();
         let area = covered_area(&capped, cover, da);
         s.plastic = Some(PlasticScalars {
             hardness_pa: hardness,

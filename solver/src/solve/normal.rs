@@ -7,6 +7,7 @@
 
 use crate::base::parallel::{Chunks, Threads};
 use crate::error::SolverError;
+use crate::model::material::limit_per_cell;
 use crate::operators::multilevel::{coarse_levels, prolong, restrict, CoarseLevel, FourierPrecond};
 use crate::operators::operator::{Operator, Z};
 
@@ -243,10 +244,25 @@ struct Level<'a> {
     cap: Option<&'a [f64]>,
 }
 
+/// One grid's normal solve: [`polonsky_keer`], or around it the plastic
+/// zone of [`plastic_zone`] when the level has caps.
+fn solve_level(
+    op: &mut impl ZzApply,
+    level: &Level,
+    p: &mut [f64],
+    u: &mut [f64],
+) -> Result<NormalReport, SolverError> {
+    match level.cap {
+        Some(cap) => plastic_zone(op, level, cap, p, u),
+        None => polonsky_keer(op, level, p, u),
+    }
+}
+
 /// Iterations after which `u = K p` is recomputed even if it could be updated.
 const REFRESH: usize = 32;
 
-/// The Polonsky–Keer iteration on one grid: `p` (any non-negative start with a
+/// The Polonsky–Keer iteration on one grid, elastic (the level's caps are
+/// [`solve_level`]'s): `p` (any non-negative start with a
 /// positive sum) is overwritten by the solution; `u` receives `K_zz p`.
 ///
 /// One operator application per iteration when the active set did not change:
@@ -265,11 +281,8 @@ fn polonsky_keer(
         tolerance,
         max_iterations,
         precondition,
-        cap,
+        ..
     } = *level;
-    if let Some(cap) = cap {
-        return plastic_zone(op, level, cap, p, u);
-    }
     let len = h.len();
     let threads = op.threads();
     let chunks = Chunks::flat(len);
@@ -756,12 +769,7 @@ pub fn solve_normal(
             ));
         }
     }
-    // The cap of a cut cell is the hardness on its covered part: a cell's
-    // pressure is its mean over the whole cell.
-    let caps: Option<Vec<f64>> = hardness.map(|hv| match op.cover() {
-        Some(cover) => cover.iter().map(|c| hv * c).collect(),
-        None => vec![hv; len],
-    });
+    let caps: Option<Vec<f64>> = hardness.map(|hv| limit_per_cell(hv, op.cover(), len));
     let h: Vec<f64> = match extra_gap {
         Some(e) => h0.iter().zip(e).map(|(a, b)| a + b).collect(),
         None => h0.to_vec(),
@@ -811,7 +819,7 @@ pub fn solve_normal(
                         cap: cl.as_deref(),
                         ..fine
                     };
-                    let rep = polonsky_keer(level, &coarse, &mut pl, &mut ul);
+                    let rep = solve_level(level, &coarse, &mut pl, &mut ul);
                     // Levels are used once per nested start: no work
                     // spectra are kept between starts.
                     level.release_work();
@@ -830,7 +838,7 @@ pub fn solve_normal(
         precond: &mut cache.precond,
         scaled: Vec::new(),
     };
-    let report = polonsky_keer(&mut fine_op, &fine, &mut p, &mut u);
+    let report = solve_level(&mut fine_op, &fine, &mut p, &mut u);
     // The preconditioner's work spectrum is not held between normal solves
     // (through the tangential solves, where a coupled case peaks).
     if let Some(pre) = &mut cache.precond {
