@@ -204,19 +204,12 @@ pub(crate) fn solve_history(
     } else {
         Vec::new()
     };
-    let (mut worn_volume, mut worn_max) = (0.0, 0.0_f64);
-    let separation = |dent: &[f64], worn: &[f64]| -> Option<Vec<f64>> {
-        if dent.is_empty() && worn.is_empty() {
-            return None;
-        }
-        let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
-        Some(
-            (0..len)
-                .map(|i| h0[i] + at(dent, i) + at(worn, i))
-                .collect(),
-        )
-    };
-    let mut dented = separation(&dent, &worn);
+    let mut worn_volume = 0.0;
+    // The separation h0 + dent + worn, rewritten in place after each
+    // increment (`None`: h0 itself, no dent and no wear).
+    let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
+    let mut dented: Option<Vec<f64>> = (!dent.is_empty() || wear.is_some())
+        .then(|| (0..len).map(|i| h0[i] + at(&dent, i)).collect());
     let mut last = ContactState {
         p: normal0.p,
         approach: normal0.approach,
@@ -365,26 +358,22 @@ pub(crate) fn solve_history(
             // to the substrate, negated (q opposes the substrate's slip).
             let (qx0, qy0) = (&last.tangential.qx, &last.tangential.qy);
             let (qx1, qy1) = (&state.tangential.qx, &state.tangential.qy);
+            // With a wear law, each cell wears by the same slip increment
+            // and means (PHYSICS.md §5d).
             let mut work = 0.0;
             for i in 0..len {
                 let (mx, my) = (0.5 * (qx0[i] + qx1[i]), 0.5 * (qy0[i] + qy1[i]));
+                let ds = [shift[0] - (vx[i] - ux[i]), shift[1] - (vy[i] - uy[i])];
                 if mx != 0.0 || my != 0.0 {
-                    work += mx * (shift[0] - (vx[i] - ux[i])) + my * (shift[1] - (vy[i] - uy[i]));
+                    work += mx * ds[0] + my * ds[1];
                 }
-            }
-            // The increment's wear, with the dissipation's slip and means.
-            if let Some(law) = wear {
-                for i in 0..len {
+                if let Some(law) = wear {
                     let pm = 0.5 * (last.p[i] + state.p[i]);
-                    if pm <= 0.0 {
-                        continue;
+                    if pm > 0.0 {
+                        let dh = law.depth(pm, [mx, my], ds);
+                        worn[i] += dh;
+                        worn_volume += dh * da;
                     }
-                    let q = [0.5 * (qx0[i] + qx1[i]), 0.5 * (qy0[i] + qy1[i])];
-                    let ds = [shift[0] - (vx[i] - ux[i]), shift[1] - (vy[i] - uy[i])];
-                    let dh = law.depth(pm, q, ds);
-                    worn[i] += dh;
-                    worn_volume += dh * da;
-                    worn_max = worn_max.max(worn[i]);
                 }
             }
             delta_t = [delta_t[0] + shift[0], delta_t[1] + shift[1]];
@@ -421,8 +410,10 @@ pub(crate) fn solve_history(
                     .zip(&state.plastic)
                     .for_each(|(d, w)| *d += w);
             }
-            if !state.plastic.is_empty() || wear.is_some() {
-                dented = separation(&dent, &worn);
+            if let Some(h) = &mut dented {
+                for (i, v) in h.iter_mut().enumerate() {
+                    *v = h0[i] + at(&dent, i) + at(&worn, i);
+                }
             }
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
@@ -438,13 +429,7 @@ pub(crate) fn solve_history(
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
-    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max);
-    if wear.is_some() {
-        output.worn_volume_m3 = Some(worn_volume);
-        output.worn_depth_max_m = Some(worn_max);
-    } else {
-        output.worn_volume_per_cycle_m3 = None;
-    }
+    let output = reduce_history(dir, rows, &points, turning_steps, force_error_max, &worn);
     Ok(HistoryState {
         last,
         converged,
@@ -499,13 +484,15 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
     }
 }
 
-/// The cycle, reversal and residual-shift reductions of a solved path.
+/// The cycle, reversal and residual-shift reductions of a solved path, and
+/// with a wear law (`worn`, the worn depth, not empty) its wear.
 fn reduce_history(
     dir: [f64; 2],
     steps: Vec<HistoryStep>,
     points: &[(f64, f64)],
     turning_steps: Vec<usize>,
     force_error_max: f64,
+    worn: &[f64],
 ) -> HistoryOutput {
     let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
     let same = |a: (f64, f64), b: (f64, f64)| {
@@ -591,7 +578,13 @@ fn reduce_history(
         regimes.push(gross);
         j = (k >= 2).then(|| Some(k - 2));
     }
-    let worn_per_cycle = cycle.map(|(s0, s1)| steps[s1].worn_volume_m3 - steps[s0].worn_volume_m3);
+    // The rows carry the volume worn so far.
+    let wear = !worn.is_empty();
+    let worn_volume = steps.last().map(|r| r.worn_volume_m3).filter(|_| wear);
+    let worn_per_cycle = cycle
+        .filter(|_| wear)
+        .map(|(s0, s1)| steps[s1].worn_volume_m3 - steps[s0].worn_volume_m3);
+    let worn_depth_max = wear.then(|| worn.iter().cloned().fold(0.0, f64::max));
     let regime = (!regimes.is_empty()).then(|| {
         if regimes.iter().all(|&g| g) {
             "gross".to_string()
@@ -615,8 +608,8 @@ fn reduce_history(
         shift_amplitude_m,
         energy_ratio,
         regime,
-        worn_volume_m3: None,
+        worn_volume_m3: worn_volume,
         worn_volume_per_cycle_m3: worn_per_cycle,
-        worn_depth_max_m: None,
+        worn_depth_max_m: worn_depth_max,
     }
 }
