@@ -92,7 +92,7 @@ fn accepted_keys() -> BTreeSet<String> {
             cycles: 2,
         }),
         wear: Some(coordinator::config::WearCfg {
-            law: "archard".into(),
+            law: coordinator::config::WearLawCfg::Archard,
             k_mm3_per_nm: Some(1e-5),
             alpha_mm3_per_j: Some(1e-5),
         }),

@@ -39,8 +39,8 @@ pub struct HistoryCfg {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WearCfg {
-    /// `archard` (dh = k p |ds|) or `energy` (dh = α |q · ds|).
-    pub law: String,
+    /// The law.
+    pub law: WearLawCfg,
     /// Archard's k, mm³/(N·m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub k_mm3_per_nm: Option<f64>,
@@ -49,20 +49,34 @@ pub struct WearCfg {
     pub alpha_mm3_per_j: Option<f64>,
 }
 
+/// `history.wear.law`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WearLawCfg {
+    /// dh = k p |ds|.
+    Archard,
+    /// dh = α |q · ds|.
+    Energy,
+}
+
 impl WearCfg {
     /// The solver's law (SI: 1 mm³/(N·m) = 1 mm³/J = 1e-9 m³/J).
     fn law(&self) -> Result<WearLaw> {
         let coefficient = |key: &str, v: Option<f64>| -> Result<f64> {
+            let law = match self.law {
+                WearLawCfg::Archard => "archard",
+                WearLawCfg::Energy => "energy",
+            };
             let v = v.ok_or_else(|| {
-                anyhow::anyhow!("history.wear.{key}: required with law = \"{}\"", self.law)
+                anyhow::anyhow!("history.wear.{key}: required with law = \"{law}\"")
             })?;
             if !(v.is_finite() && v >= 0.0) {
                 bail!("history.wear.{key} = {v}: must be finite and ≥ 0");
             }
             Ok(v * 1e-9)
         };
-        match self.law.as_str() {
-            "archard" => {
+        match self.law {
+            WearLawCfg::Archard => {
                 if self.alpha_mm3_per_j.is_some() {
                     bail!("history.wear.alpha_mm3_per_j: belongs to law = \"energy\"; Archard's law takes k_mm3_per_nm");
                 }
@@ -70,7 +84,7 @@ impl WearCfg {
                     k: coefficient("k_mm3_per_nm", self.k_mm3_per_nm)?,
                 })
             }
-            "energy" => {
+            WearLawCfg::Energy => {
                 if self.k_mm3_per_nm.is_some() {
                     bail!("history.wear.k_mm3_per_nm: belongs to law = \"archard\"; the energy law takes alpha_mm3_per_j");
                 }
@@ -78,9 +92,6 @@ impl WearCfg {
                     alpha: coefficient("alpha_mm3_per_j", self.alpha_mm3_per_j)?,
                 })
             }
-            other => bail!(
-                "history.wear.law = \"{other}\": must be \"archard\" (dh = k p |ds|) or \"energy\" (dh = α |q·ds|)"
-            ),
         }
     }
 }
