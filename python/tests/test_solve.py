@@ -169,6 +169,24 @@ def _dict_config(points=64, ratio=0.6, angle=0.0, spacing_um=None):
     }
 
 
+def assert_history_as_cli(h, cli_dir):
+    """Python's history table against the CLI's history.csv: the same
+    columns, every value the same bits."""
+    lines = (cli_dir / "history.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert list(h) == header
+    assert len(h["step"]) == len(lines) - 1
+    for k, name in enumerate(header):
+        cli_col = [line.split(",")[k] for line in lines[1:]]
+        if name == "converged":
+            assert [str(v).lower() for v in h[name]] == cli_col
+        else:
+            # The CLI writes shortest round-trip digits: parsing gives the bits.
+            assert np.array(cli_col, dtype=np.float64).tobytes() == h[name].astype(
+                np.float64
+            ).tobytes(), name
+
+
 def test_a_fretting_history_equals_the_cli_table_bit_for_bit(tmp_path, cli_solve):
     path = tmp_path / "fretting.toml"
     path.write_text(
@@ -179,19 +197,8 @@ def test_a_fretting_history_equals_the_cli_table_bit_for_bit(tmp_path, cli_solve
     res = mpcontact.solve(mpcontact.Config.from_toml(path))
     assert_same_as_cli(res, case_json, cli_dir)
     h = res.history()
-    lines = (cli_dir / "history.csv").read_text().splitlines()
-    header = lines[0].split(",")
-    assert list(h) == header
-    assert len(h["step"]) == len(lines) - 1 == 1 + 3 * 4
-    for k, name in enumerate(header):
-        cli_col = [line.split(",")[k] for line in lines[1:]]
-        if name == "converged":
-            assert [str(v).lower() for v in h[name]] == cli_col
-        else:
-            # The CLI writes shortest round-trip digits: parsing gives the bits.
-            assert np.array(cli_col, dtype=np.float64).tobytes() == h[name].astype(
-                np.float64
-            ).tobytes(), name
+    assert_history_as_cli(h, cli_dir)
+    assert len(h["step"]) == 1 + 3 * 4
     # Energy per cycle positive and equal to the sum over the cycle's rows.
     s = res.scalars
     assert s["dissipated_energy_per_cycle_j"] > 0
@@ -217,10 +224,8 @@ def test_wear_along_a_fretting_path_equals_the_cli(tmp_path, cli_solve):
     res = mpcontact.solve(mpcontact.Config.from_toml(path))
     assert_same_as_cli(res, case_json, cli_dir)
     h = res.history()
-    lines = (cli_dir / "history.csv").read_text().splitlines()
-    assert list(h) == lines[0].split(",")
-    worn = np.array([line.split(",")[-1] for line in lines[1:]], dtype=np.float64)
-    assert worn.tobytes() == h["worn_volume_m3"].tobytes()
+    assert_history_as_cli(h, cli_dir)
+    worn = h["worn_volume_m3"]
     depth = res.fields["wear"]
     assert depth.tobytes() == np.load(cli_dir / "wear.npy").tobytes()
     total = res.scalars["history"]["worn_volume_m3"]
