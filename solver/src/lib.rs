@@ -110,8 +110,8 @@ pub use model::radii::{
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
 pub use model::spec::{
-    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, WearLaw, MAX_GRID_POINTS,
-    MAX_HISTORY_STEPS,
+    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, Wear, WearLaw, MAX_GRID_POINTS,
+    MAX_HISTORY_STEPS, MAX_WEAR_JUMP,
 };
 pub use model::surface::{
     Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER, RESOLVED_CELLS_PER_PITCH,
@@ -125,6 +125,7 @@ pub use post::results::{
     K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
 };
 pub use solve::history::{
-    HistoryOutput, HistoryStep, TurningState, DISSIPATION_DEFINITION, SLIP_REGIME_DEFINITION,
+    HistoryOutput, HistoryStep, TurningState, WearCycle, DISSIPATION_DEFINITION, SCAR_DEFINITION,
+    SLIP_REGIME_DEFINITION, WEAR_JUMP_LIMIT,
 };
 pub use solve::resident::{KernelCache, Resident};

@@ -10,7 +10,7 @@
 mod common;
 
 use common::{LOAD_1A, MU_1A};
-use solver::{solve_case, KernelCache, LoadHistory, WearLaw};
+use solver::{solve_case, KernelCache, LoadHistory, Wear, WearLaw};
 
 /// Mindlin's δ* = 3μP(2 − ν)/(16 a G) on Table 1(a) Fe.
 fn delta_star() -> f64 {
@@ -29,7 +29,7 @@ fn worn(law: WearLaw, shifts: Vec<f64>, steps: usize) -> solver::CaseOutput {
         normal_forces_n: None,
         steps_per_segment: steps,
         shifts_m: Some(shifts),
-        wear: Some(law),
+        wear: Some(Wear::new(law)),
     });
     solve_case(&spec, &mut KernelCache::new()).expect("the path solves")
 }

@@ -4,7 +4,7 @@
 use super::Config;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
-use solver::{LoadHistory, WearLaw};
+use solver::{LoadHistory, Wear, WearLaw};
 
 /// `[history]`: a load path applied to every case (fretting loops,
 /// proportional loading), PHYSICS.md §5b. Either the turning points
@@ -47,6 +47,14 @@ pub struct WearCfg {
     /// The energy law's α, mm³/J.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alpha_mm3_per_j: Option<f64>,
+    /// The physical cycles the simulated ones stand for (cycle jumping;
+    /// with the fretting shorthand, at least its `cycles`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub physical_cycles: Option<f64>,
+    /// Keep the worn profiles every this many simulated cycles (and at the
+    /// last).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub save_every: Option<usize>,
 }
 
 /// `history.wear.law`.
@@ -135,8 +143,40 @@ impl HistoryCfg {
     /// of `fretting = { cycles = N }`; `None` outside a map.
     pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
         let mut path = self.path_at(amplitude_um)?;
-        path.wear = self.wear.as_ref().map(WearCfg::law).transpose()?;
+        path.wear = match &self.wear {
+            Some(w) => Some(Wear {
+                law: w.law()?,
+                jump: self.wear_jump(w)?,
+                save_every: w.save_every.unwrap_or(0),
+            }),
+            None => None,
+        };
         Ok(path)
+    }
+
+    /// The cycle jump of `history.wear.physical_cycles`: the physical
+    /// cycles per simulated fretting cycle (1 without the key).
+    fn wear_jump(&self, w: &WearCfg) -> Result<f64> {
+        let Some(physical) = w.physical_cycles else {
+            return Ok(1.0);
+        };
+        let Some(f) = &self.fretting else {
+            bail!("history.wear.physical_cycles: needs the fretting shorthand (fretting = {{ ..., cycles = N }}), whose N simulated cycles it spreads over");
+        };
+        if !(physical.is_finite() && physical >= f.cycles as f64) {
+            bail!(
+                "history.wear.physical_cycles = {physical}: must be at least the {} simulated cycles of history.fretting.cycles (each simulated cycle stands for physical_cycles / cycles physical ones)",
+                f.cycles
+            );
+        }
+        let jump = physical / f.cycles as f64;
+        if jump > solver::MAX_WEAR_JUMP {
+            bail!(
+                "history.wear.physical_cycles = {physical}: {jump:e} physical cycles per simulated one, more than {:e}; simulate more cycles (history.fretting.cycles)",
+                solver::MAX_WEAR_JUMP
+            );
+        }
+        Ok(jump)
     }
 
     /// The turning points of [`HistoryCfg::load_history_at`], without wear.

@@ -141,7 +141,57 @@ pub struct LoadHistory {
     /// increment's worn depth joins the separation the next one sees.
     /// `None`: no wear.
     #[serde(default)]
-    pub wear: Option<WearLaw>,
+    pub wear: Option<Wear>,
+}
+
+/// The wear of a load path (PHYSICS.md §5d): the law, the cycle jump and
+/// the cycles whose worn profiles are kept.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Wear {
+    /// The local law.
+    pub law: WearLaw,
+    /// Cycle jumping: the physical cycles each simulated one stands for
+    /// (each increment's wear is applied this many times, implicitly in
+    /// the pressure; see `solve_history`), ≥ 1; 1: no jump.
+    #[serde(default = "no_jump")]
+    pub jump: f64,
+    /// The worn profiles through the contact's centre are kept every this
+    /// many simulated full cycles, and at the last; 0: at the last only.
+    #[serde(default)]
+    pub save_every: usize,
+}
+
+fn no_jump() -> f64 {
+    1.0
+}
+
+/// Largest cycle jump [`Wear::jump`] accepts: a bound against a typo,
+/// far above the 10⁴–10⁶ physical cycles of a rig over tens of simulated ones.
+pub const MAX_WEAR_JUMP: f64 = 1e9;
+
+impl Wear {
+    /// A law without a jump, every profile but the last dropped.
+    pub fn new(law: WearLaw) -> Self {
+        Wear {
+            law,
+            jump: 1.0,
+            save_every: 0,
+        }
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        self.law.validate()?;
+        if !(self.jump.is_finite() && (1.0..=MAX_WEAR_JUMP).contains(&self.jump)) {
+            return Err(SolverError::invalid(
+                "history.wear.jump",
+                format!(
+                    "the physical cycles per simulated cycle must be 1 to {MAX_WEAR_JUMP:e}, got {}",
+                    self.jump
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// A local wear law (PHYSICS.md §5d): the substrate's worn depth per

@@ -101,6 +101,72 @@ pub struct HistoryOutput {
     /// With a wear law: the largest worn depth, m.
     #[serde(default)]
     pub worn_depth_max_m: Option<f64>,
+    /// With a wear law: every simulated full cycle's wear and loop, the
+    /// first first (empty without a wear law or a full cycle).
+    #[serde(default)]
+    pub wear_cycles: Vec<WearCycle>,
+    /// With a wear law and a full cycle: the largest depth a simulated
+    /// cycle wore (with its jump), relative to the approach of the path's
+    /// start. Above [`WEAR_JUMP_LIMIT`] the jump is too coarse for the
+    /// profile's transient.
+    #[serde(default)]
+    pub wear_jump_ratio: Option<f64>,
+}
+
+/// The largest depth one simulated cycle may wear, with its jump, as a
+/// fraction of the approach of the path's start, before
+/// [`HistoryOutput::wear_jump_ratio`] flags the jump. The error of a jump
+/// is first order in it; the MDR reference (bench/references) measured ~5 %
+/// on a worn partial-slip profile's transient at 1.5 % of the approach per
+/// cycle, and half that at half the jump.
+pub const WEAR_JUMP_LIMIT: f64 = 0.02;
+
+/// How a wear scar is delimited.
+pub const SCAR_DEFINITION: &str = "the cells worn deeper than 1 % of the largest worn depth; its area is their covered area, its extent along x (y) the distance between the outer edges of its outermost cells";
+
+/// Fraction of the largest worn depth that delimits the scar ([`SCAR_DEFINITION`]).
+const SCAR_FRACTION: f64 = 0.01;
+
+/// One simulated full cycle of a path with a wear law: the wear so far
+/// and the cycle's loop.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct WearCycle {
+    /// Simulated full cycles so far (1 for the first).
+    pub cycle: usize,
+    /// Physical cycles so far (`cycle` × the jump).
+    pub physical_cycles: f64,
+    /// Worn volume from the start of the path, m³.
+    pub worn_volume_m3: f64,
+    /// Volume worn per physical cycle over this simulated one, m³.
+    pub worn_volume_per_cycle_m3: f64,
+    /// Largest worn depth, m.
+    pub depth_max_m: f64,
+    /// Where it is (the cell's centre, x and y from the grid's centre), m.
+    pub depth_max_at_m: [f64; 2],
+    /// Largest depth worn over this simulated cycle (with its jump), m.
+    pub depth_increment_max_m: f64,
+    /// Area of the scar ([`SCAR_DEFINITION`]), m².
+    pub scar_area_m2: f64,
+    /// Extent of the scar along x and y, m.
+    pub scar_extent_m: [f64; 2],
+    /// Apparent contact radius at the cycle's end (`solver.radii`), m.
+    pub contact_radius_m: f64,
+    /// Smallest apparent stick radius over the cycle, m (0 in gross slip).
+    pub stick_radius_m: f64,
+    /// Force amplitude F* of the cycle, N.
+    pub force_amplitude_n: f64,
+    /// Shift amplitude δ* of the cycle, m.
+    pub shift_amplitude_m: f64,
+    /// Energy dissipated over the cycle, J.
+    pub dissipated_j: f64,
+    /// `partial` or `gross` ([`SLIP_REGIME_DEFINITION`]).
+    pub regime: String,
+    /// The worn depth along x through the contact's centre (the row
+    /// through it, the mean of the two next to it on an even grid), m; only
+    /// on saved cycles (`Wear::save_every` and the last), else empty.
+    pub profile_x_m: Vec<f64>,
+    /// The same along y.
+    pub profile_y_m: Vec<f64>,
 }
 
 /// How [`HistoryOutput::regime`] is decided.
@@ -204,6 +270,14 @@ pub(crate) fn solve_history(
     } else {
         Vec::new()
     };
+    // The increment's worn depth per cell (with a jump, its rate per Pa).
+    let mut dh = worn.clone();
+    // The worn depth at the start of the current cycle, and the cycles'
+    // records.
+    let mut worn_start = worn.clone();
+    let mut wear_cycles = Vec::new();
+    let cycle_ends = full_cycles(&points);
+    let cycles_total = cycle_ends.len();
     let mut worn_volume = 0.0;
     // The separation h0 + dent + worn, rewritten in place after each
     // increment (`None`: h0 itself, no dent and no wear).
@@ -328,7 +402,7 @@ pub(crate) fn solve_history(
             // new force. (Adding the force increment spread like the
             // pressure cost 7–9 % more iterations on Table 1a at 128².)
             let start = (&last.tangential.qx[..], &last.tangential.qy[..]);
-            let state = solve_step(
+            let mut state = solve_step(
                 res,
                 spec,
                 h_now,
@@ -367,22 +441,21 @@ pub(crate) fn solve_history(
                 if mx != 0.0 || my != 0.0 {
                     work += mx * ds[0] + my * ds[1];
                 }
-                if let Some(law) = wear {
+                if let Some(w) = wear {
                     let pm = 0.5 * (last.p[i] + state.p[i]);
-                    if pm > 0.0 {
-                        let dh = law.depth(pm, [mx, my], ds);
-                        worn[i] += dh;
-                        worn_volume += dh * da;
-                    }
+                    dh[i] = if pm > 0.0 {
+                        w.law.depth(pm, [mx, my], ds)
+                    } else {
+                        0.0
+                    };
                 }
             }
             delta_t = [delta_t[0] + shift[0], delta_t[1] + shift[1]];
             last_increment = shift[0].hypot(shift[1]);
             delta_t_max = delta_t_max.max(delta_t[0].hypot(delta_t[1]));
-            let step_converged = state.normal_report.converged
+            let mut step_converged = state.normal_report.converged
                 && state.tangential.report.converged
                 && state.coupling_converged;
-            converged &= step_converged;
             normal_iterations += state.normal_iterations;
             tangential_iterations += state.tangential_iterations;
             coupling_iterations += state.coupling_iterations;
@@ -398,28 +471,108 @@ pub(crate) fn solve_history(
                     converged: step_converged,
                 },
             );
-            r.worn_volume_m3 = worn_volume;
             if !displacement_control {
                 let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
                 force_error_max = force_error_max.max(ferr);
             }
-            rows.push(r);
             (ux, uy) = (vx, vy);
             if !state.plastic.is_empty() {
                 dent.iter_mut()
                     .zip(&state.plastic)
                     .for_each(|(d, w)| *d += w);
             }
-            if let Some(h) = &mut dented {
-                for (i, v) in h.iter_mut().enumerate() {
-                    *v = h0[i] + at(&dent, i) + at(&worn, i);
+            let rewrite = |dented: &mut Option<Vec<f64>>, dent: &[f64], worn: &[f64]| {
+                if let Some(h) = dented {
+                    for (i, v) in h.iter_mut().enumerate() {
+                        *v = h0[i] + at(dent, i) + at(worn, i);
+                    }
                 }
+            };
+            if let Some(w) = wear {
+                // The increment's wear, and the pressure on the worn surface
+                // (the next increment starts from it; at a constant load no
+                // other solve would see the wear without coupling).
+                // Without a jump the depth is explicit, the trapezoidal
+                // means' (the worn volume is α times the energy to
+                // round-off). With a jump of M cycles it is taken at the
+                // pressure it leaves, `M (dh/p̄) p`: a compliant layer in
+                // the normal solve, stable for any M (applied explicitly,
+                // M dh oscillates from cell to cell once cells are finer
+                // than ~0.03a, PHYSICS.md §5d).
+                let implicit = w.jump != 1.0;
+                if implicit {
+                    for (d, (&p0, &p1)) in dh.iter_mut().zip(last.p.iter().zip(&state.p)) {
+                        let pm = 0.5 * (p0 + p1);
+                        *d = if pm > 0.0 { w.jump * *d / pm } else { 0.0 };
+                    }
+                } else {
+                    for (i, &d) in dh.iter().enumerate() {
+                        worn[i] += d;
+                        worn_volume += d * da;
+                    }
+                }
+                rewrite(&mut dented, &dent, &worn);
+                let mut hq = Vec::new();
+                if num.coupling {
+                    hq = vec![0.0; len];
+                    res.operator.apply(
+                        &[(X, &state.tangential.qx), (Y, &state.tangential.qy)],
+                        &mut [(Z, &mut hq)],
+                    );
+                }
+                let worn_normal = res.solve_normal(&NormalProblem {
+                    extra_gap: num.coupling.then_some(&hq[..]),
+                    tolerance: num.tolerance,
+                    max_iterations: num.max_iterations,
+                    p_init: Some(&state.p),
+                    hardness: spec.limits().hardness,
+                    layer: implicit.then_some(&dh[..]),
+                    ..NormalProblem::new(dented.as_deref().unwrap_or(h0), p_k)
+                })?;
+                check(&worn_normal.p)?;
+                if implicit {
+                    for i in 0..len {
+                        let d = dh[i] * worn_normal.p[i];
+                        worn[i] += d;
+                        worn_volume += d * da;
+                    }
+                }
+                if !worn_normal.plastic.is_empty() {
+                    dent.iter_mut()
+                        .zip(&worn_normal.plastic)
+                        .for_each(|(d, w)| *d += w);
+                }
+                normal_iterations += worn_normal.report.iterations;
+                step_converged &= worn_normal.report.converged;
+                r.converged = step_converged;
+                state.p = worn_normal.p;
+                state.approach = worn_normal.approach;
             }
+            rewrite(&mut dented, &dent, &worn);
+            converged &= step_converged;
+            r.worn_volume_m3 = worn_volume;
+            rows.push(r);
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
         }
         turning_steps.push(rows.len() - 1);
         turning.push(TurningState::of(rows.len() - 1, &last));
+        let t = segment + 1;
+        if let (Some(w), true) = (wear, cycle_ends.contains(&t)) {
+            let number = wear_cycles.len() + 1;
+            let save = number == cycles_total || (w.save_every > 0 && number % w.save_every == 0);
+            wear_cycles.push(wear_cycle(
+                spec,
+                terrain,
+                &rows,
+                (turning_steps[t - 2], turning_steps[t]),
+                dir,
+                &last.p,
+                (&worn, &worn_start),
+                (w.jump, number, save),
+            ));
+            worn_start.clone_from(&worn);
+        }
     }
     // The final state's shift is δt from the start of the path, not the
     // last increment's.
@@ -429,7 +582,13 @@ pub(crate) fn solve_history(
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
-    let output = reduce_history(dir, rows, &points, turning_steps, force_error_max, &worn);
+    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max, &worn);
+    let approach0 = output.steps[0].delta_z_m;
+    output.wear_jump_ratio = wear_cycles
+        .iter()
+        .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
+        .reduce(f64::max);
+    output.wear_cycles = wear_cycles;
     Ok(HistoryState {
         last,
         converged,
@@ -437,6 +596,154 @@ pub(crate) fn solve_history(
         turning,
         worn,
     })
+}
+
+/// Whether turning points `a` and `b` are the same (to 1e-12 of their size).
+fn same_point(a: (f64, f64), b: (f64, f64)) -> bool {
+    let scale = a.0.abs().max(b.0.abs());
+    (a.0 - b.0).abs() <= 1e-12 * scale && (a.1 - b.1).abs() <= 1e-12 * scale
+}
+
+/// Whether reaching turning point `t` closes a full cycle: the two
+/// segments before it return to the point they left.
+fn closes_cycle(points: &[(f64, f64)], t: usize) -> bool {
+    t >= 2
+        && t < points.len()
+        && same_point(points[t], points[t - 2])
+        && !same_point(points[t], points[t - 1])
+}
+
+/// The turning points that close the path's full cycles, one after
+/// another: 0 → +A → −A → +A → −A → +A closes two, at the second and the
+/// third +A (the −A → +A → −A between them is not a third).
+fn full_cycles(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut ends: Vec<usize> = Vec::new();
+    for t in 0..points.len() {
+        if closes_cycle(points, t) && ends.last().is_none_or(|&e| t >= e + 2) {
+            ends.push(t);
+        }
+    }
+    ends
+}
+
+/// What the rows of a full cycle (turning steps `s0` to `s1`) say.
+struct CycleRows {
+    /// Energy dissipated over it, J.
+    dissipated: f64,
+    /// The largest |F| and |δt| along the force direction, N and m.
+    force_amplitude: f64,
+    shift_amplitude: f64,
+    /// At some increment no contact cell sticks.
+    gross: bool,
+}
+
+fn cycle_rows(steps: &[HistoryStep], (s0, s1): (usize, usize), dir: [f64; 2]) -> CycleRows {
+    let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
+    let rows = &steps[s0..=s1];
+    CycleRows {
+        dissipated: rows[1..].iter().map(|r| r.dissipated_j).sum(),
+        force_amplitude: rows
+            .iter()
+            .map(|r| along(r.force_n).abs())
+            .fold(0.0, f64::max),
+        shift_amplitude: rows
+            .iter()
+            .map(|r| along(r.delta_t_m).abs())
+            .fold(0.0, f64::max),
+        gross: rows[1..]
+            .iter()
+            .any(|r| r.stick_area_m2 == 0.0 && r.contact_area_m2 > 0.0),
+    }
+}
+
+/// The record of a simulated full cycle (turning steps `s0`, `s1`) ending
+/// with pressure `p`: the worn depth `worn` (`start` at the cycle's
+/// start) and the cycle's rows; `(jump, cycle, save)`: the physical
+/// cycles per simulated one, its number, and whether to keep its profiles.
+#[allow(clippy::too_many_arguments)]
+fn wear_cycle(
+    spec: &CaseSpec,
+    terrain: &Terrain,
+    rows: &[HistoryStep],
+    (s0, s1): (usize, usize),
+    dir: [f64; 2],
+    p: &[f64],
+    (worn, start): (&[f64], &[f64]),
+    (jump, cycle, save): (f64, usize, bool),
+) -> WearCycle {
+    let grid = spec.grid;
+    let n = grid.n;
+    let looped = cycle_rows(rows, (s0, s1), dir);
+    let (mut deepest, mut depth_max) = (0, 0.0);
+    for (i, &d) in worn.iter().enumerate() {
+        if d > depth_max {
+            (deepest, depth_max) = (i, d);
+        }
+    }
+    let increment = worn
+        .iter()
+        .zip(start)
+        .map(|(a, b)| a - b)
+        .fold(0.0, f64::max);
+    let scar: Vec<bool> = worn
+        .iter()
+        .map(|&d| depth_max > 0.0 && d > SCAR_FRACTION * depth_max)
+        .collect();
+    let extent = |coord: &dyn Fn(usize) -> f64, spacing: f64| {
+        let (lo, hi) = (0..grid.len())
+            .filter(|&i| scar[i])
+            .map(coord)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        if hi >= lo {
+            hi - lo + spacing
+        } else {
+            0.0
+        }
+    };
+    let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
+    let stick_radius = rows[s0 + 1..=s1]
+        .iter()
+        .map(|r| r.stick_radius_m)
+        .fold(f64::INFINITY, f64::min);
+    // The cuts through the centre: the middle row (column), or the mean of
+    // the two next to the centre on an even grid.
+    let (lo, hi) = ((n - 1) / 2, n / 2);
+    let (profile_x_m, profile_y_m) = if save {
+        (
+            (0..n)
+                .map(|ix| 0.5 * (worn[lo * n + ix] + worn[hi * n + ix]))
+                .collect(),
+            (0..n)
+                .map(|iy| 0.5 * (worn[iy * n + lo] + worn[iy * n + hi]))
+                .collect(),
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    WearCycle {
+        cycle,
+        physical_cycles: cycle as f64 * jump,
+        worn_volume_m3: rows[s1].worn_volume_m3,
+        worn_volume_per_cycle_m3: (rows[s1].worn_volume_m3 - rows[s0].worn_volume_m3) / jump,
+        depth_max_m: depth_max,
+        depth_max_at_m: [grid.x(deepest % n), grid.y(deepest / n)],
+        depth_increment_max_m: increment,
+        scar_area_m2: covered_area(&scar, terrain.cover.as_deref(), grid.cell_area()),
+        scar_extent_m: [
+            extent(&|i| grid.x(i % n), grid.dx),
+            extent(&|i| grid.y(i / n), grid.dy),
+        ],
+        contact_radius_m: apparent_radius(spec.numerics.radii, &grid, &contact, p, terrain),
+        stick_radius_m: if looped.gross { 0.0 } else { stick_radius },
+        force_amplitude_n: looped.force_amplitude,
+        shift_amplitude_m: looped.shift_amplitude,
+        dissipated_j: looped.dissipated,
+        regime: if looped.gross { "gross" } else { "partial" }.to_string(),
+        profile_x_m,
+        profile_y_m,
+    }
 }
 
 /// What a row needs besides the contact state.
@@ -495,18 +802,14 @@ fn reduce_history(
     worn: &[f64],
 ) -> HistoryOutput {
     let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
-    let same = |a: (f64, f64), b: (f64, f64)| {
-        let scale = a.0.abs().max(b.0.abs());
-        (a.0 - b.0).abs() <= 1e-12 * scale && (a.1 - b.1).abs() <= 1e-12 * scale
-    };
     // The last full cycle: segments j, j+1 that return to turning point j.
     let cycle = (0..points.len().saturating_sub(2))
         .rev()
-        .find(|&j| same(points[j], points[j + 2]) && !same(points[j], points[j + 1]))
+        .find(|&j| closes_cycle(points, j + 2))
         .map(|j| (turning_steps[j], turning_steps[j + 2]));
     let (dissipated, loop_area) = match cycle {
         Some((s0, s1)) => {
-            let d: f64 = steps[s0 + 1..=s1].iter().map(|r| r.dissipated_j).sum();
+            let d = cycle_rows(&steps, (s0, s1), dir).dissipated;
             let area: f64 = (s0 + 1..=s1)
                 .map(|k| {
                     let (a, b) = (&steps[k - 1], &steps[k]);
@@ -550,15 +853,8 @@ fn reduce_history(
     // Amplitudes and the energy ratio of the last cycle.
     let (force_amplitude_n, shift_amplitude_m, energy_ratio) = match (cycle, dissipated) {
         (Some((s0, s1)), Some(w)) => {
-            let rows = &steps[s0..=s1];
-            let f = rows
-                .iter()
-                .map(|r| along(r.force_n).abs())
-                .fold(0.0, f64::max);
-            let d = rows
-                .iter()
-                .map(|r| along(r.delta_t_m).abs())
-                .fold(0.0, f64::max);
+            let rows = cycle_rows(&steps, (s0, s1), dir);
+            let (f, d) = (rows.force_amplitude, rows.shift_amplitude);
             let ratio = (f > 0.0 && d > 0.0).then(|| w / (4.0 * f * d));
             (Some(f), Some(d), ratio)
         }
@@ -568,14 +864,11 @@ fn reduce_history(
     let mut regimes = Vec::new();
     let mut j = cycle.map(|(s0, _)| turning_steps.iter().position(|&t| t == s0));
     while let Some(Some(k)) = j {
-        if k + 2 >= points.len() || !same(points[k], points[k + 2]) {
+        if k + 2 >= points.len() || !same_point(points[k], points[k + 2]) {
             break;
         }
         let (s0, s1) = (turning_steps[k], turning_steps[k + 2]);
-        let gross = steps[s0 + 1..=s1]
-            .iter()
-            .any(|r| r.stick_area_m2 == 0.0 && r.contact_area_m2 > 0.0);
-        regimes.push(gross);
+        regimes.push(cycle_rows(&steps, (s0, s1), dir).gross);
         j = (k >= 2).then(|| Some(k - 2));
     }
     // The rows carry the volume worn so far.
@@ -611,5 +904,7 @@ fn reduce_history(
         worn_volume_m3: worn_volume,
         worn_volume_per_cycle_m3: worn_per_cycle,
         worn_depth_max_m: worn_depth_max,
+        wear_cycles: Vec::new(),
+        wear_jump_ratio: None,
     }
 }

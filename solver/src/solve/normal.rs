@@ -111,6 +111,31 @@ impl ZzApply for CoarseLevel {
     }
 }
 
+/// An operator with a compliant layer on top: `uz = K p + c p`, `c` per
+/// cell in m/Pa. It is how a load history takes the wear of a cycle jump
+/// implicitly (the depth `c p` worn at the pressure it leaves, see
+/// `history.rs`): the layer only adds to the diagonal, so the iteration
+/// and its preconditioner are those of `K`.
+struct Layered<'a, Z> {
+    inner: &'a mut Z,
+    layer: &'a [f64],
+}
+
+impl<Z: ZzApply> ZzApply for Layered<'_, Z> {
+    fn threads(&self) -> Threads {
+        self.inner.threads()
+    }
+    fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
+        self.inner.apply_zz(p, uz);
+        for ((u, &pi), &c) in uz.iter_mut().zip(p).zip(self.layer) {
+            *u += c * pi;
+        }
+    }
+    fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
+        self.inner.precondition(g, active, z);
+    }
+}
+
 /// What the normal solver keeps per operator between cases: the Galerkin
 /// coarse `K_zz` levels of nested starts, the Fourier preconditioner of
 /// the fine grid (made on first use) and the last contact solved from rest
@@ -715,6 +740,10 @@ pub struct NormalProblem<'a> {
     /// covered part of every cell (an elastic–perfectly plastic surface);
     /// `None`: elastic, no cap.
     pub hardness: Option<f64>,
+    /// A compliant layer per cell, m/Pa: the surface under a cell of
+    /// pressure `p` lies `layer · p` lower (the returned `uz` includes it).
+    /// A load history's implicit wear; `None`: no layer.
+    pub layer: Option<&'a [f64]>,
 }
 
 impl<'a> NormalProblem<'a> {
@@ -730,6 +759,7 @@ impl<'a> NormalProblem<'a> {
             p_init: None,
             options: NormalOptions::default(),
             hardness: None,
+            layer: None,
         }
     }
 }
@@ -751,6 +781,7 @@ pub fn solve_normal(
         p_init,
         options,
         hardness,
+        layer,
     } = *prob;
     let grid = op.grid();
     let len = grid.len();
@@ -838,7 +869,16 @@ pub fn solve_normal(
         precond: &mut cache.precond,
         scaled: Vec::new(),
     };
-    let report = solve_level(&mut fine_op, &fine, &mut p, &mut u);
+    let report = match layer {
+        Some(layer) => {
+            let mut layered = Layered {
+                inner: &mut fine_op,
+                layer,
+            };
+            solve_level(&mut layered, &fine, &mut p, &mut u)
+        }
+        None => solve_level(&mut fine_op, &fine, &mut p, &mut u),
+    };
     // The preconditioner's work spectrum is not held between normal solves
     // (through the tangential solves, where a coupled case peaks).
     if let Some(pre) = &mut cache.precond {
@@ -848,6 +888,11 @@ pub fn solve_normal(
     report.coarse_iterations = coarse_iterations;
     // Final state and residuals from the returned pressure.
     op.normal(&p, &mut u);
+    if let Some(layer) = layer {
+        for ((u, &pi), &c) in u.iter_mut().zip(&p).zip(layer) {
+            *u += c * pi;
+        }
+    }
     // The approach is the gap of the cells in elastic contact (below their
     // caps); with every contact cell capped, the largest capped gap.
     let at_cap = |i: usize| caps.as_ref().is_some_and(|c| p[i] >= c[i]);
@@ -913,7 +958,7 @@ pub fn solve_normal_from_rest(
     cache: &mut NormalCache,
     prob: &NormalProblem,
 ) -> Result<NormalSolution, SolverError> {
-    if prob.p_init.is_some() || prob.extra_gap.is_some() {
+    if prob.p_init.is_some() || prob.extra_gap.is_some() || prob.layer.is_some() {
         // Not a contact from rest: solved, nothing kept.
         return solve_normal(op, cache, prob);
     }
