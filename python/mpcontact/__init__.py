@@ -110,6 +110,62 @@ class Result:
             table["worn_volume_m3"] = col(lambda r: r["worn_volume_m3"])
         return table
 
+    def wear(self):
+        """The wear record of a path with ``history.wear``, else ``None``: a
+        dict of 1-D arrays, one entry per simulated cycle, named as the
+        columns of the CLI's ``wear.csv`` (``cycle``, ``physical_cycles``,
+        ``worn_volume_m3``, ``worn_volume_per_cycle_m3``, ``depth_max_m``,
+        ``depth_max_x_m``, ``depth_max_y_m``, ``depth_increment_max_m``,
+        ``scar_area_m2``, ``scar_extent_x_m``, ``scar_extent_y_m``,
+        ``contact_radius_m``, ``stick_radius_m``, ``force_amplitude_n``,
+        ``shift_amplitude_m``, ``dissipated_j``, ``regime``)."""
+        h = self.scalars.get("history")
+        if h is None or not h.get("wear_cycles"):
+            return None
+        import numpy as np
+
+        cycles = h["wear_cycles"]
+
+        def col(get, dtype=np.float64):
+            return np.array([get(c) for c in cycles], dtype=dtype)
+
+        return {
+            "cycle": col(lambda c: c["cycle"], np.int64),
+            "physical_cycles": col(lambda c: c["physical_cycles"]),
+            "worn_volume_m3": col(lambda c: c["worn_volume_m3"]),
+            "worn_volume_per_cycle_m3": col(lambda c: c["worn_volume_per_cycle_m3"]),
+            "depth_max_m": col(lambda c: c["depth_max_m"]),
+            "depth_max_x_m": col(lambda c: c["depth_max_at_m"][0]),
+            "depth_max_y_m": col(lambda c: c["depth_max_at_m"][1]),
+            "depth_increment_max_m": col(lambda c: c["depth_increment_max_m"]),
+            "scar_area_m2": col(lambda c: c["scar_area_m2"]),
+            "scar_extent_x_m": col(lambda c: c["scar_extent_m"][0]),
+            "scar_extent_y_m": col(lambda c: c["scar_extent_m"][1]),
+            "contact_radius_m": col(lambda c: c["contact_radius_m"]),
+            "stick_radius_m": col(lambda c: c["stick_radius_m"]),
+            "force_amplitude_n": col(lambda c: c["force_amplitude_n"]),
+            "shift_amplitude_m": col(lambda c: c["shift_amplitude_m"]),
+            "dissipated_j": col(lambda c: c["dissipated_j"]),
+            "regime": col(lambda c: c["regime"], object),
+        }
+
+    def wear_profiles(self):
+        """The worn profiles through the contact's centre at the saved
+        cycles (``history.wear.save_every`` and the last), as the CLI's
+        ``wear_profiles.csv``: ``(position_m, {cycle: (along_x, along_y)})``
+        with 1-D arrays, or ``None`` without a wear law."""
+        h = self.scalars.get("history")
+        if h is None or not h.get("wear_cycles"):
+            return None
+        import numpy as np
+
+        saved = {
+            c["cycle"]: (np.array(c["profile_x_m"]), np.array(c["profile_y_m"]))
+            for c in h["wear_cycles"]
+            if c["profile_x_m"]
+        }
+        return np.array(h["wear_profile_at_m"]), saved
+
     def __repr__(self):
         s = self.scalars
         return (

@@ -231,6 +231,33 @@ def test_wear_along_a_fretting_path_equals_the_cli(tmp_path, cli_solve):
     total = res.scalars["history"]["worn_volume_m3"]
     assert total == worn[-1] > 0.0
     assert depth.sum() * (4e-6) ** 2 == pytest.approx(total, rel=1e-12)
+    # The record per simulated cycle and the profiles, as wear.csv and
+    # wear_profiles.csv.
+    w = res.wear()
+    lines = (cli_dir / "wear.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    assert list(w) == header
+    assert len(lines) == 2 and w["cycle"].tolist() == [1]
+    for k, name in enumerate(header):
+        cli_col = [line.split(",")[k] for line in lines[1:]]
+        if name == "regime":
+            assert w[name].tolist() == cli_col
+        else:
+            assert np.array(cli_col, dtype=np.float64).tobytes() == w[name].astype(
+                np.float64
+            ).tobytes(), name
+    assert w["worn_volume_m3"][-1] == total
+    assert w["depth_max_m"][-1] == depth.max()
+    at, saved = res.wear_profiles()
+    cli = np.loadtxt(cli_dir / "wear_profiles.csv", delimiter=",", skiprows=1)
+    assert list(saved) == [1]
+    assert at.tobytes() == cli[:, 0].tobytes()
+    assert saved[1][0].tobytes() == cli[:, 1].tobytes()
+    assert saved[1][1].tobytes() == cli[:, 2].tobytes()
+    # The cut along x through the centre of the even grid: the mean of the
+    # two middle rows.
+    n = depth.shape[0]
+    assert np.array_equal(saved[1][0], 0.5 * (depth[n // 2 - 1] + depth[n // 2]))
 
 
 def test_an_elastic_ball_from_python_equals_the_cli_and_softens_the_contact(

@@ -100,3 +100,183 @@ fn the_energy_law_wears_alpha_times_the_dissipated_energy() {
     );
     assert!((per_cycle / (alpha * w) - 1.0).abs() < 1e-6);
 }
+
+/// Table 1(a) Fe at 128² of 2.5 µm (the domain spans 1.6 a: a worn
+/// partial-slip contact grows past the Hertz radius), coupling off, under
+/// `cycles` fretting cycles of ±0.6 μP (10 increments per segment), Archard
+/// wear with `k`, each simulated cycle standing for `jump` physical ones.
+fn fretted(k: f64, cycles: usize, jump: f64) -> solver::CaseOutput {
+    let mut spec = common::table_1a_fe(128, 2.5, false, 0.0);
+    let mut ratios = vec![0.0, 0.6];
+    for _ in 0..cycles {
+        ratios.extend([-0.6, 0.6]);
+    }
+    spec.history = Some(LoadHistory {
+        tangential_ratios: ratios,
+        normal_forces_n: None,
+        steps_per_segment: 10,
+        shifts_m: None,
+        wear: Some(Wear {
+            law: WearLaw::Archard { k },
+            jump,
+            save_every: 0,
+        }),
+    });
+    solve_case(&spec, &mut KernelCache::new()).expect("the path solves")
+}
+
+/// Hertz's radius and E* of Table 1(a) Fe.
+fn hertz_1a() -> (f64, f64) {
+    let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
+    let es = e / (1.0 - nu * nu);
+    ((3.0 * LOAD_1A * r / (4.0 * es)).cbrt(), es)
+}
+
+#[test]
+fn partial_slip_wear_confines_the_pressure_to_the_stick_zone() {
+    // PHYSICS.md §5d: under a constant force amplitude the slip annulus
+    // wears until it carries nothing, the stick radius stays, and the
+    // pressure tends to Ciavarella & Hills's sphere on a contact confined
+    // to r < c.
+    let (a, es) = hertz_1a();
+    let r_ball = 18.0e-3;
+    let c = a * 0.4_f64.cbrt();
+    let ch = |r: f64| {
+        if r >= c {
+            return 0.0;
+        }
+        let s = (c * c - r * r).sqrt();
+        2.0 * es / (std::f64::consts::PI * r_ball) * s
+            + (LOAD_1A - 4.0 * es * c.powi(3) / (3.0 * r_ball))
+                / (2.0 * std::f64::consts::PI * c * s)
+    };
+    let (n, h) = (128, 2.5e-6);
+    let da = h * h;
+    let at = |i: usize| {
+        let x = (i % n) as f64 - 0.5 * (n as f64 - 1.0);
+        let y = (i / n) as f64 - 0.5 * (n as f64 - 1.0);
+        x.hypot(y) * h
+    };
+    // The limit averaged over each cell (8 × 8 points: it is singular at
+    // c), the load outside c and the distance ∫|p − p_CH| dA.
+    let sub = 8;
+    let limit: Vec<f64> = (0..n * n)
+        .map(|i| {
+            let (x0, y0) = (
+                (i % n) as f64 - 0.5 * n as f64,
+                (i / n) as f64 - 0.5 * n as f64,
+            );
+            let mut s = 0.0;
+            for u in 0..sub {
+                for v in 0..sub {
+                    let x = (x0 + (u as f64 + 0.5) / sub as f64) * h;
+                    let y = (y0 + (v as f64 + 0.5) / sub as f64) * h;
+                    s += ch(x.hypot(y));
+                }
+            }
+            s / (sub * sub) as f64
+        })
+        .collect();
+    // The limit's own singular edge cannot be matched cell by cell: within
+    // two cells of c the loads are compared, elsewhere the pressures.
+    let band = |i: usize| (at(i) - c).abs() <= 2.0 * h;
+    let measure = |p: &[f64]| {
+        let outside: f64 = (0..p.len())
+            .filter(|&i| at(i) > c + 2.0 * h)
+            .map(|i| p[i])
+            .sum::<f64>()
+            * da;
+        let (mut off, mut on) = (0.0, 0.0);
+        for i in 0..p.len() {
+            if band(i) {
+                on += p[i] - limit[i];
+            } else {
+                off += (p[i] - limit[i]).abs();
+            }
+        }
+        (outside / LOAD_1A, (off + on.abs()) * da / LOAD_1A)
+    };
+    // A jump of 2e5 cycles per simulated one at k = 1e-5 mm³/(N·m): the
+    // first simulated cycle wears ~4 % of the approach.
+    let k = 1e-5 * 1e-9;
+    let mut rows = Vec::new();
+    for cycles in [1, 4, 12] {
+        let out = fretted(k, cycles, 2e5);
+        assert!(out.scalars.converged, "{cycles} cycles");
+        let hist = out.scalars.history.expect("a path");
+        let last = hist.wear_cycles.last().expect("a cycle").clone();
+        let (outside, distance) = measure(&out.fields.p);
+        println!(
+            "{cycles:>2} cycles: load beyond c + 2 cells {outside:.4} P, distance to the limit {distance:.4} P, stick radius {:.4} c, depth {:.3e} m, energy {:.3e} J",
+            last.stick_radius_m / c,
+            last.depth_max_m,
+            last.dissipated_j
+        );
+        rows.push((outside, distance, last));
+    }
+    // The stick radius stays (Mindlin's c, to the apparent radius's
+    // discretisation).
+    for (_, _, last) in &rows {
+        assert!((last.stick_radius_m / c - 1.0).abs() < 0.02);
+    }
+    // The load leaves the slip annulus, the pressure approaches the limit
+    // (to a floor: see docs/validation.md), and the energy per cycle falls
+    // as the annulus stops slipping under load.
+    assert!(rows[1].0 < 0.2 * rows[0].0 && rows[2].0 < 1e-3);
+    assert!(rows[1].1 < 0.25 * rows[0].1 && rows[2].1 < 0.25 * rows[0].1);
+    assert!(rows[2].2.dissipated_j < 0.05 * rows[0].2.dissipated_j);
+}
+
+#[test]
+fn a_cycle_jump_converges_at_first_order() {
+    // The same 8e4 physical cycles as 2, 4 and 8 simulated ones: the worn
+    // volume and the largest depth change by about half as much each time
+    // the jump is halved (the scheme is first order in the jump).
+    let k = 1e-5 * 1e-9;
+    let ends: Vec<(f64, f64)> = [2usize, 4, 8]
+        .iter()
+        .map(|&cycles| {
+            let out = fretted(k, cycles, 8e4 / cycles as f64);
+            assert!(out.scalars.converged);
+            let hist = out.scalars.history.expect("a path");
+            let last = hist.wear_cycles.last().expect("a cycle").clone();
+            assert_eq!(last.physical_cycles, 8e4);
+            // The records agree with the path's totals and the field.
+            assert_eq!(hist.wear_cycles.len(), cycles);
+            assert_eq!(Some(last.worn_volume_m3), hist.worn_volume_m3);
+            let deepest = out.fields.wear.iter().cloned().fold(0.0, f64::max);
+            assert_eq!(last.depth_max_m, deepest);
+            let per_cycle: f64 = hist
+                .wear_cycles
+                .iter()
+                .map(|c| c.worn_volume_per_cycle_m3)
+                .sum();
+            let first_loading = hist.steps[hist.turning_steps[1]].worn_volume_m3;
+            let jump = 8e4 / cycles as f64;
+            assert!(
+                (first_loading + per_cycle * jump - last.worn_volume_m3).abs()
+                    < 1e-9 * last.worn_volume_m3
+            );
+            assert!(
+                last.profile_x_m.len() == 128
+                    && hist.wear_cycles[0].profile_x_m.is_empty() == (cycles > 1)
+            );
+            println!(
+                "jump {:>6}: volume {:.6e} m³, depth {:.6e} m",
+                8e4 / cycles as f64,
+                last.worn_volume_m3,
+                last.depth_max_m
+            );
+            (last.worn_volume_m3, last.depth_max_m)
+        })
+        .collect();
+    for (name, pick) in [("volume", 0usize), ("depth", 1)] {
+        let v = |j: usize| if pick == 0 { ends[j].0 } else { ends[j].1 };
+        let (d1, d2) = ((v(0) - v(1)).abs(), (v(1) - v(2)).abs());
+        println!(
+            "{name}: differences {d1:.3e}, {d2:.3e} (ratio {:.2})",
+            d2 / d1
+        );
+        assert!(d2 < 0.7 * d1, "{name}");
+    }
+}

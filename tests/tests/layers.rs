@@ -76,6 +76,7 @@ fn coordinator() -> Layers {
             ("output", "npy"),
             ("output", "plot"),
             ("output", "maps"),
+            ("output", "wear"),
             ("output", "history"),
             ("output", "stress"),
             ("output", "sweep"),

@@ -375,6 +375,61 @@ mod tests {
     }
 
     #[test]
+    fn issue49_wear_keys_their_jump_and_their_errors() {
+        let with = |h: &str| format!("{BASE}\n[history]\n{h}\n");
+        let fretting = "fretting = { amplitude_ratio = 0.5, cycles = 4 }";
+        let cases = [
+            (
+                format!("{fretting}\nwear = {{ law = \"archerd\", k_mm3_per_nm = 1e-5 }}"),
+                "unknown variant `archerd`, expected `archard` or `energy`",
+            ),
+            (
+                format!("{fretting}\nwear = {{ law = \"archard\" }}"),
+                "history.wear.k_mm3_per_nm: required with law = \"archard\"",
+            ),
+            (
+                format!("{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = -1.0 }}"),
+                "history.wear.k_mm3_per_nm = -1: must be finite and ≥ 0",
+            ),
+            (
+                format!("{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = 1e-5, physical_cycles = 3.0 }}"),
+                "history.wear.physical_cycles = 3: must be at least the 4 simulated cycles",
+            ),
+            (
+                format!("{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = 1e-5, physical_cycles = 1e12 }}"),
+                "physical cycles per simulated one, more than 1e9",
+            ),
+            (
+                "tangential_ratios = [0.0, 0.5, -0.5, 0.5]\nwear = { law = \"archard\", k_mm3_per_nm = 1e-5, physical_cycles = 1e4 }".to_string(),
+                "history.wear.physical_cycles: needs the fretting shorthand",
+            ),
+        ];
+        for (h, expect) in cases {
+            let e = err(&with(&h), &[]);
+            assert!(e.contains(expect), "{h}: {e}");
+        }
+        // 1e4 physical cycles over 4 simulated: a jump of 2500.
+        let c = Config::parse(
+            &with(&format!("{fretting}\nwear = {{ law = \"energy\", alpha_mm3_per_j = 2e-5, physical_cycles = 1e4, save_every = 2 }}")),
+            &[],
+        )
+        .unwrap();
+        let w = c.load_history().unwrap().wear.unwrap();
+        assert_eq!(w.jump, 2500.0);
+        assert_eq!(w.save_every, 2);
+        assert_eq!(w.law, solver::WearLaw::Energy { alpha: 2e-5 * 1e-9 });
+        // Without the key, no jump.
+        let c = Config::parse(
+            &with(&format!(
+                "{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = 1e-5 }}"
+            )),
+            &[],
+        )
+        .unwrap();
+        assert_eq!(c.load_history().unwrap().wear.unwrap().jump, 1.0);
+    }
+
+    #[test]
     fn issue37_displacement_controlled_paths_and_their_errors() {
         let with = |h: &str| format!("{BASE}\n[history]\n{h}\n");
         let cases: [(&str, &str); 5] = [

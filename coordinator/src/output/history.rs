@@ -161,7 +161,8 @@ impl Figure for Hysteresis<'_> {
     }
 }
 
-/// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`.
+/// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`,
+/// and with a wear law the files of [`super::wear::write_wear`].
 /// The table is written first; a picture that cannot be drawn is returned
 /// as a warning, not an error.
 pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
@@ -173,6 +174,8 @@ pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<S
             warnings.push(format!("{name}: {e:#}"));
         }
     }
+    warnings.extend(super::wear::write_wear(dir, h, title)?);
+    warnings.extend(super::wear::jump_warning(h).map(|w| format!("{title}: {w}")));
     Ok(warnings)
 }
 

@@ -7,8 +7,8 @@
 //! `tests/tests/layers.rs` checks it from the sources):
 //! `atomic` (every file whole or not at all) → `npy` (arrays) → `plot` (one
 //! figure on PNG or SVG, frames, colours, the colour bar) → `maps` (field
-//! maps of a case, [`maps::Heat`]) → `history` (a load history's table and
-//! loop) → `stress` (`[stress]` of a case: arrays and maps) → `sweep`
+//! maps of a case, [`maps::Heat`]) → `wear` (a worn path's table and
+//! profiles) → `history` (a load history's table and loop) → `stress` (`[stress]` of a case: arrays and maps) → `sweep`
 //! (`results.csv`, `curves.csv`, the μa figure, `fields/<case>/`) →
 //! `fretting_map`, `orientation_map` (a sweep's maps over its axes).
 
@@ -21,3 +21,4 @@ pub(crate) mod orientation_map;
 pub mod plot;
 pub mod stress;
 pub(crate) mod sweep;
+pub mod wear;

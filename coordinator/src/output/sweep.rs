@@ -280,6 +280,9 @@ pub struct CurvePoint {
     pub stress: Option<StressScalars>,
     /// On a surface with a hardness: the finest level's plastic zone.
     pub plastic: Option<solver::PlasticScalars>,
+    /// With a wear law: the finest level's worn volume over the path (m³)
+    /// and largest worn depth (m).
+    pub wear: Option<(f64, f64)>,
 }
 
 /// The curve points of `rows`: each material × surface × angle whose
@@ -338,6 +341,10 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
             dissipated,
             plastic: finest.plastic,
+            wear: finest
+                .history
+                .as_ref()
+                .and_then(|h| Some((h.worn_volume_m3?, h.worn_depth_max_m?))),
             stress: rs
                 .iter()
                 .rev()
@@ -351,6 +358,10 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
 /// Columns `curves.csv` gains when the sweep has a load history.
 pub const CURVES_HISTORY_COLUMNS: &str = "dissipated_j,dissipated_j_err";
 
+/// Columns `curves.csv` gains when the sweep's path wears the surface
+/// (the finest level's).
+pub const CURVES_WEAR_COLUMNS: &str = "worn_volume_m3,worn_depth_max_m";
+
 /// Text of `curves.csv` (with [`INDENTER_COLUMN`] in a sweep over balls,
 /// and [`CURVES_HISTORY_COLUMNS`] when any point has a dissipated energy
 /// per cycle).
@@ -358,11 +369,16 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
     let history = points.iter().any(|p| p.dissipated.is_some());
     let stress = points.iter().any(|p| p.stress.is_some());
     let plastic = points.iter().any(|p| p.plastic.is_some());
+    let wear = points.iter().any(|p| p.wear.is_some());
     let axes = Axes::of(points.iter().map(|p| &p.key));
     let mut out = header_with_axes(CURVES_HEADER, axes);
     if history {
         out.push(',');
         out.push_str(CURVES_HISTORY_COLUMNS);
+    }
+    if wear {
+        out.push(',');
+        out.push_str(CURVES_WEAR_COLUMNS);
     }
     if plastic {
         out.push(',');
@@ -395,6 +411,14 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
                 ",{},{}",
                 opt(p.dissipated.as_ref().map(|d| d.value)),
                 opt(p.dissipated.as_ref().and_then(|d| d.err)),
+            );
+        }
+        if wear {
+            let _ = write!(
+                out,
+                ",{},{}",
+                opt(p.wear.map(|w| w.0)),
+                opt(p.wear.map(|w| w.1))
             );
         }
         if plastic {
@@ -600,6 +624,24 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
                 .insert(surface, e);
         }
     }
+    // With a wear law: the worn volume over the path, per material, in µm³.
+    let mut worn: BTreeMap<&str, Panel> = BTreeMap::new();
+    for ((material, surface), pts) in by_curve(points) {
+        let v: Vec<(f64, f64, Option<f64>)> = pts
+            .iter()
+            .filter_map(|p| Some((p.key.angle_deg, p.wear?.0 * 1e18, None)))
+            .collect();
+        if !v.is_empty() {
+            worn.entry(material)
+                .or_insert_with(|| Panel {
+                    title: format!("{material}: worn volume"),
+                    y_desc: "worn volume over the path (μm³)",
+                    series: BTreeMap::new(),
+                })
+                .series
+                .insert(surface, v);
+        }
+    }
     // With [stress]: the largest von Mises stress over p_H, per material.
     let mut stress: BTreeMap<&str, Panel> = BTreeMap::new();
     for ((material, surface), pts) in by_curve(points) {
@@ -624,6 +666,7 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     panels.extend(energy.into_values());
+    panels.extend(worn.into_values());
     panels.extend(stress.into_values());
     if !k_e.series.is_empty() {
         panels.push(k_e);

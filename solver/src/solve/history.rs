@@ -111,6 +111,10 @@ pub struct HistoryOutput {
     /// profile's transient.
     #[serde(default)]
     pub wear_jump_ratio: Option<f64>,
+    /// With a wear law: the positions of the points of the worn profiles
+    /// ([`WearCycle::profile_x_m`] and `profile_y_m`) from the centre, m.
+    #[serde(default)]
+    pub wear_profile_at_m: Vec<f64>,
 }
 
 /// The largest depth one simulated cycle may wear, with its jump, as a
@@ -588,6 +592,9 @@ pub(crate) fn solve_history(
         .iter()
         .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
         .reduce(f64::max);
+    if wear.is_some() {
+        output.wear_profile_at_m = (0..grid.n).map(|i| grid.x(i)).collect();
+    }
     output.wear_cycles = wear_cycles;
     Ok(HistoryState {
         last,
@@ -906,5 +913,6 @@ fn reduce_history(
         worn_depth_max_m: worn_depth_max,
         wear_cycles: Vec::new(),
         wear_jump_ratio: None,
+        wear_profile_at_m: Vec::new(),
     }
 }

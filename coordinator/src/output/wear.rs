@@ -1,0 +1,255 @@
+//! The files of a case whose load path wears the surface: `wear.csv` (one
+//! row per simulated cycle), `wear_profiles.csv` (the worn depth through
+//! the contact's centre along x and y at the saved cycles) and the same
+//! profiles overlaid as PNG and SVG, as fretting papers print a scar.
+//! Used by `mpcontact solve` and, per case, by a sweep; computes nothing
+//! the solver did not.
+
+use crate::float_text::fmt_f64;
+use anyhow::Result;
+use plotters::prelude::*;
+use solver::{HistoryOutput, WearCycle};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plot::{self, err, Area, Figure, Frame, PALETTE};
+
+/// Header of `wear.csv`.
+pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime";
+
+/// Text of `wear.csv`.
+pub fn wear_csv(h: &HistoryOutput) -> String {
+    let mut out = String::from(WEAR_HEADER);
+    out.push('\n');
+    for c in &h.wear_cycles {
+        let cells = [
+            c.physical_cycles,
+            c.worn_volume_m3,
+            c.worn_volume_per_cycle_m3,
+            c.depth_max_m,
+            c.depth_max_at_m[0],
+            c.depth_max_at_m[1],
+            c.depth_increment_max_m,
+            c.scar_area_m2,
+            c.scar_extent_m[0],
+            c.scar_extent_m[1],
+            c.contact_radius_m,
+            c.stick_radius_m,
+            c.force_amplitude_n,
+            c.shift_amplitude_m,
+            c.dissipated_j,
+        ];
+        let _ = write!(out, "{}", c.cycle);
+        for v in cells {
+            let _ = write!(out, ",{}", fmt_f64(v));
+        }
+        let _ = writeln!(out, ",{}", c.regime);
+    }
+    out
+}
+
+/// The cycles whose profiles were kept.
+fn saved(h: &HistoryOutput) -> Vec<&WearCycle> {
+    h.wear_cycles
+        .iter()
+        .filter(|c| !c.profile_x_m.is_empty())
+        .collect()
+}
+
+/// Text of `wear_profiles.csv`: the position from the centre, then per
+/// saved cycle its depth along x and along y.
+pub fn profiles_csv(h: &HistoryOutput) -> String {
+    let cycles = saved(h);
+    let mut out = String::from("position_m");
+    for c in &cycles {
+        let _ = write!(out, ",x_cycle_{0},y_cycle_{0}", c.cycle);
+    }
+    out.push('\n');
+    for (i, &at) in h.wear_profile_at_m.iter().enumerate() {
+        out.push_str(&fmt_f64(at));
+        for c in &cycles {
+            let _ = write!(
+                out,
+                ",{},{}",
+                fmt_f64(c.profile_x_m[i]),
+                fmt_f64(c.profile_y_m[i])
+            );
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// A saved cycle's profiles as drawn: its label, then (position, surface)
+/// along x and along y, in µm with the depth negative.
+type ProfileLine = (String, Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+/// The profiles as drawn.
+struct Profiles<'a> {
+    lines: Vec<ProfileLine>,
+    title: &'a str,
+}
+
+fn profile_lines(h: &HistoryOutput) -> Vec<ProfileLine> {
+    let line = |p: &[f64]| -> Vec<(f64, f64)> {
+        h.wear_profile_at_m
+            .iter()
+            .zip(p)
+            .map(|(&x, &d)| (x * 1e6, -d * 1e6))
+            .collect()
+    };
+    saved(h)
+        .into_iter()
+        .map(|c| {
+            let label = format!("{:.0} cycles", c.physical_cycles);
+            (label, line(&c.profile_x_m), line(&c.profile_y_m))
+        })
+        .collect()
+}
+
+impl Figure for Profiles<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
+        let pts = self
+            .lines
+            .iter()
+            .flat_map(|(_, x, y)| x.iter().chain(y.iter()));
+        let (mut xlo, mut xhi, mut ylo) = (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64);
+        for &(x, y) in pts {
+            xlo = xlo.min(x);
+            xhi = xhi.max(x);
+            ylo = ylo.min(y);
+        }
+        if !xlo.is_finite() || xhi <= xlo {
+            (xlo, xhi) = (-1.0, 1.0);
+        }
+        if ylo >= 0.0 {
+            ylo = -1e-6;
+        }
+        let yp = -ylo * 0.08;
+        let panels = root.split_evenly((1, 2));
+        let frame = Frame {
+            title: 16,
+            margin: 12,
+            labels: (44, 70),
+        };
+        for (k, panel) in panels.iter().enumerate() {
+            let axis = ["x (the force direction at 0°)", "y"][k];
+            let mut chart = frame.chart(
+                panel,
+                &format!("{}: worn depth along {axis}", self.title),
+                xlo..xhi,
+                (ylo - yp)..yp,
+            )?;
+            chart
+                .configure_mesh()
+                .x_desc(format!("{} through the centre (μm)", ["x", "y"][k]))
+                .y_desc("surface (μm, worn depth below 0)")
+                .draw()
+                .map_err(err)?;
+            for (j, (label, x, y)) in self.lines.iter().enumerate() {
+                let colour = PALETTE[j % PALETTE.len()];
+                let line = if k == 0 { x } else { y };
+                chart
+                    .draw_series(LineSeries::new(
+                        line.iter().copied(),
+                        colour.stroke_width(2),
+                    ))
+                    .map_err(err)?
+                    .label(label.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .background_style(WHITE.mix(0.9))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes `wear.csv`, `wear_profiles.csv` and `wear_profiles.png|svg` into
+/// `dir` when the path wore the surface (nothing otherwise). The tables
+/// are written first; a picture that cannot be drawn is returned as a
+/// warning, not an error.
+pub fn write_wear(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
+    if h.wear_cycles.is_empty() {
+        return Ok(Vec::new());
+    }
+    std::fs::create_dir_all(dir)?;
+    super::atomic::write(&dir.join("wear.csv"), wear_csv(h).as_bytes())?;
+    super::atomic::write(&dir.join("wear_profiles.csv"), profiles_csv(h).as_bytes())?;
+    let figure = Profiles {
+        lines: profile_lines(h),
+        title,
+    };
+    let mut warnings = Vec::new();
+    for name in ["wear_profiles.png", "wear_profiles.svg"] {
+        if let Err(e) = plot::write(&dir.join(name), (1200, 480), &figure) {
+            warnings.push(format!("{name}: {e:#}"));
+        }
+    }
+    Ok(warnings)
+}
+
+/// The warning a path whose cycle jump is too coarse gives (see
+/// [`solver::WEAR_JUMP_LIMIT`]), or `None`.
+pub fn jump_warning(h: &HistoryOutput) -> Option<String> {
+    let ratio = h.wear_jump_ratio?;
+    (ratio > solver::WEAR_JUMP_LIMIT).then(|| {
+        format!(
+            "a simulated cycle wore up to {:.1} % of the approach (above {} %): the cycle jump (history.wear.physical_cycles / history.fretting.cycles) may be too coarse for the worn profile's transient; simulate more cycles and compare",
+            100.0 * ratio,
+            100.0 * solver::WEAR_JUMP_LIMIT
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn worn() -> HistoryOutput {
+        let cycle = |k: usize, saved: bool| WearCycle {
+            cycle: k,
+            physical_cycles: 100.0 * k as f64,
+            worn_volume_m3: 1e-15 * k as f64,
+            regime: "partial".into(),
+            profile_x_m: if saved { vec![0.0, 2e-8, 0.0] } else { vec![] },
+            profile_y_m: if saved { vec![0.0, 1e-8, 0.0] } else { vec![] },
+            ..Default::default()
+        };
+        HistoryOutput {
+            wear_cycles: vec![cycle(1, false), cycle(2, true)],
+            wear_profile_at_m: vec![-1e-6, 0.0, 1e-6],
+            wear_jump_ratio: Some(0.05),
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn the_wear_table_has_a_row_per_cycle_and_the_profiles_a_column_per_saved_cycle() {
+        let h = worn();
+        let text = wear_csv(&h);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3);
+        assert_eq!(lines[0], WEAR_HEADER);
+        assert!(lines[2].starts_with("2,200,2e-15,"), "{}", lines[2]);
+        assert!(lines[2].ends_with(",partial"), "{}", lines[2]);
+        assert_eq!(
+            lines[0].split(',').count(),
+            lines[2].split(',').count(),
+            "a value per column"
+        );
+        let profiles = profiles_csv(&h);
+        let rows: Vec<&str> = profiles.lines().collect();
+        assert_eq!(rows[0], "position_m,x_cycle_2,y_cycle_2");
+        assert_eq!(rows[2], "0,2e-8,1e-8");
+        assert!(jump_warning(&h).is_some_and(|w| w.contains("5.0 %")));
+        assert!(jump_warning(&HistoryOutput::default()).is_none());
+    }
+}
