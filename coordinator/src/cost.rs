@@ -31,6 +31,12 @@ pub const CASE_EXPONENT: f64 = 2.35;
 /// (commit 19ee3eb; before it the monotonic solves were slower, 0.55×).
 const INCREMENT_COST: f64 = 0.6;
 
+/// With a wear law each increment adds a normal solve on the worn surface:
+/// about 0.11 of a coupled monotonic solve, with coupling or without
+/// (bench/wear.sh at 256² of 1.25 µm: 0.055 s and 0.048 s an increment
+/// against a coupled monotonic solve's 0.45 s).
+const WEAR_INCREMENT_COST: f64 = 0.11;
+
 /// A case on a surface with a hardness costs about 2.5 elastic ones: the
 /// paper's Table 1(c) surfaces at 512² took 2.0–2.1× the elastic sweep's
 /// time with H = 0.9 GPa and 3.2–3.4× with 0.5 GPa (docs/performance.md,
@@ -46,7 +52,11 @@ pub fn case_seconds(spec: &CaseSpec) -> f64 {
     match &spec.history {
         Some(h) => {
             let segments = h.turning_points(&spec.load).len().saturating_sub(1);
-            one * INCREMENT_COST * (segments * h.steps_per_segment).max(1) as f64
+            let increment = match h.wear {
+                Some(_) => INCREMENT_COST + WEAR_INCREMENT_COST,
+                None => INCREMENT_COST,
+            };
+            one * increment * (segments * h.steps_per_segment).max(1) as f64
         }
         None => one,
     }

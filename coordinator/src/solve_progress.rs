@@ -1,6 +1,7 @@
 //! How `mpcontact solve` shows it is working: one live line on stderr with
-//! the elapsed time and the solver's phase (load increment k of n, coupling
-//! pass, normal or tangential iteration), on a terminal only and never with
+//! the elapsed time and the solver's phase (load increment k of n and the
+//! path's time left, coupling pass, normal or tangential iteration), on a
+//! terminal only and never with
 //! `--quiet`. Owns only stderr; reads the phase through the solver's tick
 //! hook, so no number of the solve changes. `run`'s bar is `run::progress`.
 
@@ -37,18 +38,27 @@ impl SolveProgress {
                 .unwrap_or_else(|_| ProgressStyle::default_spinner()),
         );
         bar.set_prefix(case.to_string());
-        bar.set_message(describe(&Phase::default()));
+        bar.set_message(describe(&Phase::default(), None));
         // The spinner and the clock move even while one iteration of a large
         // grid, or a kernel build, takes seconds between ticks.
         bar.enable_steady_tick(REFRESH);
         let shown = bar.clone();
         let mut last: Option<Instant> = None;
+        // A load path's first increment seen and when: the rate since then
+        // gives the time left (a long wear run's thousands of increments
+        // cost about the same each).
+        let mut first: Option<(usize, Instant)> = None;
         let previous = solver::set_tick_hook(Some(Box::new(move || {
             if last.is_some_and(|t| t.elapsed() < REFRESH) {
                 return;
             }
             last = Some(Instant::now());
-            shown.set_message(describe(&solver::phase()));
+            let phase = solver::phase();
+            let left = phase.increment.and_then(|(k, n)| {
+                let &mut (k0, t0) = first.get_or_insert((k, Instant::now()));
+                time_left(k0, t0.elapsed(), k, n)
+            });
+            shown.set_message(describe(&phase, left));
         })));
         Some(SolveProgress { bar, previous })
     }
@@ -61,13 +71,30 @@ impl Drop for SolveProgress {
     }
 }
 
-/// The text of the line for `phase` (after the elapsed time and the case),
-/// e.g. `increment 3/80 · pass 2 · tangential iteration 145` (the pass is
-/// the coupling loop's). Short enough for 80 columns after the case.
-pub fn describe(phase: &Phase) -> String {
+/// The time a path has left at increment `k` of `n`, from the `elapsed`
+/// time since increment `k0` began: the increments done since then at
+/// their mean rate (`None` until one is done).
+pub fn time_left(k0: usize, elapsed: Duration, k: usize, n: usize) -> Option<Duration> {
+    let done = k.checked_sub(k0).filter(|&d| d > 0)?;
+    Some(elapsed.mul_f64((n + 1).saturating_sub(k) as f64 / done as f64))
+}
+
+/// The text of the line for `phase` (after the elapsed time and the case)
+/// with the path's time `left`, e.g. `increment 3/80 · about 1m05s left ·
+/// pass 2 · tangential iteration 145` (the pass is the coupling loop's).
+/// Short enough for 80 columns after the case.
+pub fn describe(phase: &Phase, left: Option<Duration>) -> String {
     let mut parts = Vec::new();
     if let Some((k, n)) = phase.increment {
         parts.push(format!("increment {k}/{n}"));
+    }
+    if let Some(left) = left {
+        let s = left.as_secs();
+        parts.push(if s >= 3600 {
+            format!("about {}h{:02}m left", s / 3600, s % 3600 / 60)
+        } else {
+            format!("about {}m{:02}s left", s / 60, s % 60)
+        });
     }
     if let Some(k) = phase.pass {
         parts.push(format!("pass {k}"));
@@ -94,8 +121,30 @@ mod tests {
             iterations: 145,
         };
         assert_eq!(
-            describe(&phase),
+            describe(&phase, None),
             "increment 3/80 · pass 2 · tangential iteration 145"
+        );
+        assert_eq!(
+            describe(&phase, Some(Duration::from_secs(65))),
+            "increment 3/80 · about 1m05s left · pass 2 · tangential iteration 145"
+        );
+        assert_eq!(
+            describe(&phase, Some(Duration::from_secs(3 * 3600 + 7 * 60))),
+            "increment 3/80 · about 3h07m left · pass 2 · tangential iteration 145"
+        );
+    }
+
+    #[test]
+    fn the_time_left_is_the_rate_so_far_over_the_increments_to_go() {
+        // Seen first at increment 1; at increment 11 of 100, 10 done in
+        // 20 s: 90 to go (11 included) at 2 s.
+        let left = time_left(1, Duration::from_secs(20), 11, 100);
+        assert_eq!(left, Some(Duration::from_secs(180)));
+        assert_eq!(time_left(5, Duration::from_secs(3), 5, 100), None);
+        // At the last increment, what it takes at the rate so far.
+        assert_eq!(
+            time_left(90, Duration::from_secs(20), 100, 100),
+            Some(Duration::from_secs(2))
         );
     }
 
@@ -106,12 +155,12 @@ mod tests {
             iterations: 12,
             ..Phase::default()
         };
-        assert_eq!(describe(&normal), "normal iteration 12");
+        assert_eq!(describe(&normal, None), "normal iteration 12");
         let kernel = Phase {
             stage: Stage::Kernel,
             ..Phase::default()
         };
-        assert_eq!(describe(&kernel), "building the kernel");
-        assert_eq!(describe(&Phase::default()), "starting");
+        assert_eq!(describe(&kernel, None), "building the kernel");
+        assert_eq!(describe(&Phase::default(), None), "starting");
     }
 }

@@ -118,7 +118,8 @@ class Result:
         ``depth_max_x_m``, ``depth_max_y_m``, ``depth_increment_max_m``,
         ``scar_area_m2``, ``scar_extent_x_m``, ``scar_extent_y_m``,
         ``contact_radius_m``, ``stick_radius_m``, ``force_amplitude_n``,
-        ``shift_amplitude_m``, ``dissipated_j``, ``regime``)."""
+        ``shift_amplitude_m``, ``dissipated_j``, ``regime``,
+        ``worn_through_cells``)."""
         h = self.scalars.get("history")
         if h is None or not h.get("wear_cycles"):
             return None
@@ -147,6 +148,7 @@ class Result:
             "shift_amplitude_m": col(lambda c: c["shift_amplitude_m"]),
             "dissipated_j": col(lambda c: c["dissipated_j"]),
             "regime": col(lambda c: c["regime"], object),
+            "worn_through_cells": col(lambda c: c["worn_through_cells"], np.int64),
         }
 
     def wear_profiles(self):

@@ -280,3 +280,43 @@ fn a_cycle_jump_converges_at_first_order() {
         assert!(d2 < 0.7 * d1, "{name}");
     }
 }
+
+#[test]
+fn islands_worn_through_are_counted() {
+    // Circular islands 20 nm high (the approach is 0.6 µm) under a cycle
+    // that wears ~0.1 µm: the slip annulus's islands are worn through, and
+    // the record counts their cells; 2 µm islands are not.
+    let count = |height: f64| {
+        let mut spec = common::table_1a_fe(64, 5.0, false, 0.0);
+        spec.surface = solver::Surface::Lattice {
+            island: solver::Island::Circle { diameter: 24e-6 },
+            pitch: 40e-6,
+            height,
+            offset: [0.0, 0.0],
+            lattice: solver::LatticeKind::Square,
+            sampling: solver::Sampling::Area,
+        };
+        spec.history = Some(LoadHistory {
+            tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
+            normal_forces_n: None,
+            steps_per_segment: 5,
+            shifts_m: None,
+            wear: Some(Wear {
+                law: WearLaw::Archard { k: 1e-5 * 1e-9 },
+                jump: 2e6,
+                save_every: 0,
+            }),
+        });
+        let out = solve_case(&spec, &mut KernelCache::new()).expect("the path solves");
+        let last = out.scalars.history.expect("a path").wear_cycles[0].clone();
+        println!(
+            "islands {height:e} m: depth {:.3e} m, {} cells worn through",
+            last.depth_max_m, last.worn_through_cells
+        );
+        (last.depth_max_m, last.worn_through_cells)
+    };
+    let (depth, through) = count(20e-9);
+    assert!(depth > 2.0 * 20e-9 && through > 0);
+    let (depth, through) = count(2e-6);
+    assert!(depth < 2e-6 && through == 0);
+}

@@ -175,7 +175,11 @@ pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<S
         }
     }
     warnings.extend(super::wear::write_wear(dir, h, title)?);
-    warnings.extend(super::wear::jump_warning(h).map(|w| format!("{title}: {w}")));
+    warnings.extend(
+        super::wear::wear_warnings(h)
+            .into_iter()
+            .map(|w| format!("{title}: {w}")),
+    );
     Ok(warnings)
 }
 

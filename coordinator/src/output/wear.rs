@@ -15,7 +15,7 @@ use std::path::Path;
 use super::plot::{self, err, Area, Figure, Frame, PALETTE};
 
 /// Header of `wear.csv`.
-pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime";
+pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime,worn_through_cells";
 
 /// Text of `wear.csv`.
 pub fn wear_csv(h: &HistoryOutput) -> String {
@@ -43,7 +43,7 @@ pub fn wear_csv(h: &HistoryOutput) -> String {
         for v in cells {
             let _ = write!(out, ",{}", fmt_f64(v));
         }
-        let _ = writeln!(out, ",{}", c.regime);
+        let _ = writeln!(out, ",{},{}", c.regime, c.worn_through_cells);
     }
     out
 }
@@ -196,17 +196,27 @@ pub fn write_wear(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<Stri
     Ok(warnings)
 }
 
-/// The warning a path whose cycle jump is too coarse gives (see
-/// [`solver::WEAR_JUMP_LIMIT`]), or `None`.
-pub fn jump_warning(h: &HistoryOutput) -> Option<String> {
-    let ratio = h.wear_jump_ratio?;
-    (ratio > solver::WEAR_JUMP_LIMIT).then(|| {
-        format!(
+/// The warnings of a worn path: a cycle jump too coarse (see
+/// [`solver::WEAR_JUMP_LIMIT`]), islands worn through.
+pub fn wear_warnings(h: &HistoryOutput) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if let Some(ratio) = h.wear_jump_ratio.filter(|&r| r > solver::WEAR_JUMP_LIMIT) {
+        warnings.push(format!(
             "a simulated cycle wore up to {:.1} % of the approach (above {} %): the cycle jump (history.wear.physical_cycles / history.fretting.cycles) may be too coarse for the worn profile's transient; simulate more cycles and compare",
             100.0 * ratio,
             100.0 * solver::WEAR_JUMP_LIMIT
-        )
-    })
+        ));
+    }
+    if let Some(c) = h.wear_cycles.iter().find(|c| c.worn_through_cells > 0) {
+        warnings.push(format!(
+            "islands worn through from simulated cycle {} ({:.0} physical cycles): {} cells worn deeper than their island's height, {} by the end; the pattern no longer describes them (wear.csv, worn_through_cells)",
+            c.cycle,
+            c.physical_cycles,
+            c.worn_through_cells,
+            h.wear_cycles.last().map_or(0, |l| l.worn_through_cells)
+        ));
+    }
+    warnings
 }
 
 #[cfg(test)]
@@ -239,7 +249,7 @@ mod tests {
         assert_eq!(lines.len(), 3);
         assert_eq!(lines[0], WEAR_HEADER);
         assert!(lines[2].starts_with("2,200,2e-15,"), "{}", lines[2]);
-        assert!(lines[2].ends_with(",partial"), "{}", lines[2]);
+        assert!(lines[2].ends_with(",partial,0"), "{}", lines[2]);
         assert_eq!(
             lines[0].split(',').count(),
             lines[2].split(',').count(),
@@ -249,7 +259,17 @@ mod tests {
         let rows: Vec<&str> = profiles.lines().collect();
         assert_eq!(rows[0], "position_m,x_cycle_2,y_cycle_2");
         assert_eq!(rows[2], "0,2e-8,1e-8");
-        assert!(jump_warning(&h).is_some_and(|w| w.contains("5.0 %")));
-        assert!(jump_warning(&HistoryOutput::default()).is_none());
+        let warnings = wear_warnings(&h);
+        assert!(warnings.len() == 1 && warnings[0].contains("5.0 %"));
+        assert!(wear_warnings(&HistoryOutput::default()).is_empty());
+        let mut through = h.clone();
+        through.wear_jump_ratio = Some(0.01);
+        through.wear_cycles[1].worn_through_cells = 12;
+        let warnings = wear_warnings(&through);
+        assert!(
+            warnings.len() == 1
+                && warnings[0].contains("from simulated cycle 2 (200 physical cycles): 12 cells"),
+            "{warnings:?}"
+        );
     }
 }

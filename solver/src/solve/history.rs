@@ -165,6 +165,10 @@ pub struct WearCycle {
     pub dissipated_j: f64,
     /// `partial` or `gross` ([`SLIP_REGIME_DEFINITION`]).
     pub regime: String,
+    /// Cells of a pattern's islands worn deeper than the island stands
+    /// above the base (worn through: the pattern, and a cut cell's load on
+    /// its upper part, no longer describe them); 0 on a flat surface.
+    pub worn_through_cells: usize,
     /// The worn depth along x through the contact's centre (the row
     /// through it, the mean of the two next to it on an even grid), m; only
     /// on saved cycles (`Wear::save_every` and the last), else empty.
@@ -710,6 +714,17 @@ fn wear_cycle(
         }
     };
     let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
+    let base = terrain
+        .heights
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min);
+    let worn_through_cells = terrain
+        .heights
+        .iter()
+        .zip(worn)
+        .filter(|&(&z, &d)| z > base && d > z - base)
+        .count();
     let stick_radius = rows[s0 + 1..=s1]
         .iter()
         .map(|r| r.stick_radius_m)
@@ -748,6 +763,7 @@ fn wear_cycle(
         shift_amplitude_m: looped.shift_amplitude,
         dissipated_j: looped.dissipated,
         regime: if looped.gross { "gross" } else { "partial" }.to_string(),
+        worn_through_cells,
         profile_x_m,
         profile_y_m,
     }
