@@ -95,6 +95,8 @@ fn accepted_keys() -> BTreeSet<String> {
             law: coordinator::config::WearLawCfg::Archard,
             k_mm3_per_nm: Some(1e-5),
             alpha_mm3_per_j: Some(1e-5),
+            ball_k_mm3_per_nm: Some(1e-6),
+            ball_alpha_mm3_per_j: Some(1e-6),
             physical_cycles: Some(1e4),
             save_every: Some(5),
         }),

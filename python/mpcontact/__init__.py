@@ -119,7 +119,7 @@ class Result:
         ``scar_area_m2``, ``scar_extent_x_m``, ``scar_extent_y_m``,
         ``contact_radius_m``, ``stick_radius_m``, ``force_amplitude_n``,
         ``shift_amplitude_m``, ``dissipated_j``, ``regime``,
-        ``worn_through_cells``)."""
+        ``worn_through_cells``, ``ball_worn_volume_m3``, ``ball_depth_max_m``)."""
         h = self.scalars.get("history")
         if h is None or not h.get("wear_cycles"):
             return None
@@ -149,6 +149,8 @@ class Result:
             "dissipated_j": col(lambda c: c["dissipated_j"]),
             "regime": col(lambda c: c["regime"], object),
             "worn_through_cells": col(lambda c: c["worn_through_cells"], np.int64),
+            "ball_worn_volume_m3": col(lambda c: c["ball_worn_volume_m3"]),
+            "ball_depth_max_m": col(lambda c: c["ball_depth_max_m"]),
         }
 
     def wear_profiles(self):

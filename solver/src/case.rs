@@ -105,5 +105,6 @@ fn solve_history_case(
     out.scalars.converged &= converged;
     out.turning = turning;
     out.fields.wear = solved.worn;
+    out.fields.ball_wear = solved.ball_worn;
     Ok(out)
 }

@@ -118,6 +118,7 @@ fn fretted(k: f64, cycles: usize, jump: f64) -> solver::CaseOutput {
         shifts_m: None,
         wear: Some(Wear {
             law: WearLaw::Archard { k },
+            ball: None,
             jump,
             save_every: 0,
         }),
@@ -303,6 +304,7 @@ fn islands_worn_through_are_counted() {
             shifts_m: None,
             wear: Some(Wear {
                 law: WearLaw::Archard { k: 1e-5 * 1e-9 },
+                ball: None,
                 jump: 2e6,
                 save_every: 0,
             }),
@@ -319,4 +321,93 @@ fn islands_worn_through_are_counted() {
     assert!(depth > 2.0 * 20e-9 && through > 0);
     let (depth, through) = count(2e-6);
     assert!(depth < 2e-6 && through == 0);
+}
+
+/// Table 1(a) Fe on `n`² cells of `spacing_um`, coupling off, under the
+/// imposed shifts `shifts` (10 increments per segment), the substrate
+/// wearing with Archard's `k` and the ball with `k_ball`.
+fn both_wear(
+    n: usize,
+    spacing_um: f64,
+    shifts: Vec<f64>,
+    k: f64,
+    k_ball: f64,
+) -> solver::CaseOutput {
+    let mut spec = common::table_1a_fe(n, spacing_um, false, 0.0);
+    spec.history = Some(LoadHistory {
+        tangential_ratios: Vec::new(),
+        normal_forces_n: None,
+        steps_per_segment: 10,
+        shifts_m: Some(shifts),
+        wear: Some(Wear {
+            law: WearLaw::Archard { k },
+            ball: Some(WearLaw::Archard { k: k_ball }),
+            jump: 1.0,
+            save_every: 0,
+        }),
+    });
+    solve_case(&spec, &mut KernelCache::new()).expect("the path solves")
+}
+
+#[test]
+fn the_ball_wears_by_its_own_coefficient_in_its_own_frame() {
+    // Gross slip at Δ = 3δ*, the ball with half the substrate's k: every
+    // cell's ball wear is half the substrate's, and the ball's frame keeps
+    // the volume as it moves, so its volume is half the substrate's.
+    let k = 1e-20;
+    let a3 = 3.0 * delta_star();
+    let out = both_wear(128, 2.0, vec![0.0, a3, -a3, a3], k, 0.5 * k);
+    let h = out.scalars.history.expect("a path");
+    let (sub, ball) = (
+        h.worn_volume_m3.expect("worn"),
+        h.ball_worn_volume_m3.expect("the ball wore"),
+    );
+    let field: f64 = out.fields.ball_wear.iter().sum::<f64>() * 4e-12;
+    println!("substrate {sub:.9e} m³, ball {ball:.9e} m³ (field {field:.9e})");
+    assert!((ball / (0.5 * sub) - 1.0).abs() < 1e-12);
+    assert!((field / ball - 1.0).abs() < 1e-12);
+    let last = h.wear_cycles.last().expect("a cycle");
+    assert_eq!(last.ball_worn_volume_m3, ball);
+
+    // Gross slip at Δ = 20 µm (7 cells of 3 µm) with one body wearing at a
+    // time: the same volume either way (k P times the sliding distance),
+    // but the substrate's scar spans the contact's travel, 2(a + Δ), and
+    // the ball's, which moves with its contact, only the contact, 2a.
+    let d = 20e-6;
+    let path = vec![0.0, d, -d, d];
+    let substrate = both_wear(128, 3.0, path.clone(), k, 0.0);
+    let on_ball = both_wear(128, 3.0, path, 0.0, k);
+    let hs = substrate.scalars.history.expect("a path");
+    let hb = on_ball.scalars.history.expect("a path");
+    let (vs, vb) = (
+        hs.worn_volume_m3.expect("worn"),
+        hb.ball_worn_volume_m3.expect("worn"),
+    );
+    let extent = |w: &[f64]| {
+        let max = w.iter().cloned().fold(0.0, f64::max);
+        let cols: Vec<usize> = (0..w.len())
+            .filter(|&i| w[i] > 0.01 * max)
+            .map(|i| i % 128)
+            .collect();
+        let (lo, hi) = (cols.iter().min().unwrap(), cols.iter().max().unwrap());
+        (hi - lo + 1) as f64 * 3e-6
+    };
+    let (es, eb) = (
+        extent(&substrate.fields.wear),
+        extent(&on_ball.fields.ball_wear),
+    );
+    let a = out.scalars.contact_radius_m;
+    println!(
+        "Δ = 20 µm: volumes substrate {vs:.6e}, ball {vb:.6e} m³; scar along x: substrate {:.1} µm (2(a + Δ) = {:.1}), ball {:.1} µm (2a = {:.1})",
+        es * 1e6,
+        2e6 * (a + d),
+        eb * 1e6,
+        2e6 * a
+    );
+    assert!((vb / vs - 1.0).abs() < 0.01);
+    assert!((es - 2.0 * (a + d)).abs() < 4.0 * 3e-6);
+    assert!((eb - 2.0 * a).abs() < 4.0 * 3e-6);
+    assert!(((es - eb) - 2.0 * d).abs() < 3.0 * 3e-6);
+    assert!(substrate.fields.ball_wear.iter().all(|&v| v == 0.0));
+    assert!(on_ball.fields.wear.iter().all(|&v| v == 0.0));
 }

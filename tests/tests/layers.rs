@@ -47,6 +47,7 @@ fn solver() -> Layers {
             ("solve", "tangential_displacement"),
             ("solve", "resident"),
             ("solve", "coupling"),
+            ("solve", "wear"),
             ("solve", "history"),
             ("post", "results"),
             ("post", "stress_summary"),

@@ -47,6 +47,12 @@ pub struct WearCfg {
     /// The energy law's α, mm³/J.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alpha_mm3_per_j: Option<f64>,
+    /// The ball's Archard k, mm³/(N·m), if it wears too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ball_k_mm3_per_nm: Option<f64>,
+    /// The ball's energy-law α, mm³/J, if it wears too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ball_alpha_mm3_per_j: Option<f64>,
     /// The physical cycles the simulated ones stand for (cycle jumping;
     /// with the fretting shorthand, at least its `cycles`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -68,39 +74,58 @@ pub enum WearLawCfg {
 }
 
 impl WearCfg {
-    /// The solver's law (SI: 1 mm³/(N·m) = 1 mm³/J = 1e-9 m³/J).
-    fn law(&self) -> Result<WearLaw> {
-        let coefficient = |key: &str, v: Option<f64>| -> Result<f64> {
-            let law = match self.law {
-                WearLawCfg::Archard => "archard",
-                WearLawCfg::Energy => "energy",
-            };
-            let v = v.ok_or_else(|| {
-                anyhow::anyhow!("history.wear.{key}: required with law = \"{law}\"")
-            })?;
+    /// The solver's laws of the substrate and of the ball (SI: 1 mm³/(N·m)
+    /// = 1 mm³/J = 1e-9 m³/J).
+    fn laws(&self) -> Result<(WearLaw, Option<WearLaw>)> {
+        let law = match self.law {
+            WearLawCfg::Archard => "archard",
+            WearLawCfg::Energy => "energy",
+        };
+        let coefficient = |key: &str, v: f64| -> Result<f64> {
             if !(v.is_finite() && v >= 0.0) {
                 bail!("history.wear.{key} = {v}: must be finite and ≥ 0");
             }
             Ok(v * 1e-9)
         };
-        match self.law {
-            WearLawCfg::Archard => {
-                if self.alpha_mm3_per_j.is_some() {
-                    bail!("history.wear.alpha_mm3_per_j: belongs to law = \"energy\"; Archard's law takes k_mm3_per_nm");
-                }
-                Ok(WearLaw::Archard {
-                    k: coefficient("k_mm3_per_nm", self.k_mm3_per_nm)?,
-                })
-            }
-            WearLawCfg::Energy => {
-                if self.k_mm3_per_nm.is_some() {
-                    bail!("history.wear.k_mm3_per_nm: belongs to law = \"archard\"; the energy law takes alpha_mm3_per_j");
-                }
-                Ok(WearLaw::Energy {
-                    alpha: coefficient("alpha_mm3_per_j", self.alpha_mm3_per_j)?,
-                })
+        let (own, other, ball, other_ball, make): (_, _, _, _, fn(f64) -> WearLaw) = match self.law
+        {
+            WearLawCfg::Archard => (
+                ("k_mm3_per_nm", self.k_mm3_per_nm),
+                ("alpha_mm3_per_j", self.alpha_mm3_per_j),
+                ("ball_k_mm3_per_nm", self.ball_k_mm3_per_nm),
+                ("ball_alpha_mm3_per_j", self.ball_alpha_mm3_per_j),
+                |k| WearLaw::Archard { k },
+            ),
+            WearLawCfg::Energy => (
+                ("alpha_mm3_per_j", self.alpha_mm3_per_j),
+                ("k_mm3_per_nm", self.k_mm3_per_nm),
+                ("ball_alpha_mm3_per_j", self.ball_alpha_mm3_per_j),
+                ("ball_k_mm3_per_nm", self.ball_k_mm3_per_nm),
+                |alpha| WearLaw::Energy { alpha },
+            ),
+        };
+        for (key, v) in [other, other_ball] {
+            if v.is_some() {
+                bail!(
+                    "history.wear.{key}: belongs to the other law; law = \"{law}\" takes {} (and {} for the ball)",
+                    own.0,
+                    ball.0
+                );
             }
         }
+        let v = own.1.ok_or_else(|| {
+            anyhow::anyhow!(
+                "history.wear.{}: required with law = \"{law}\" (0 if only the ball wears)",
+                own.0
+            )
+        })?;
+        let substrate = make(coefficient(own.0, v)?);
+        let ball = ball
+            .1
+            .map(|v| coefficient(ball.0, v))
+            .transpose()?
+            .map(make);
+        Ok((substrate, ball))
     }
 }
 
@@ -144,10 +169,14 @@ impl HistoryCfg {
     pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
         let mut path = self.path_at(amplitude_um)?;
         path.wear = match &self.wear {
-            Some(w) => Some(Wear {
-                law: w.law()?,
-                jump: self.wear_jump(w)?,
-                save_every: w.save_every.unwrap_or(0),
+            Some(w) => Some({
+                let (law, ball) = w.laws()?;
+                Wear {
+                    law,
+                    ball,
+                    jump: self.wear_jump(w)?,
+                    save_every: w.save_every.unwrap_or(0),
+                }
             }),
             None => None,
         };
@@ -418,6 +447,23 @@ mod tests {
         assert_eq!(w.jump, 2500.0);
         assert_eq!(w.save_every, 2);
         assert_eq!(w.law, solver::WearLaw::Energy { alpha: 2e-5 * 1e-9 });
+        // The ball wears by the same law with its own coefficient.
+        let c = Config::parse(
+            &with(&format!("{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = 0.0, ball_k_mm3_per_nm = 3e-6 }}")),
+            &[],
+        )
+        .unwrap();
+        let w = c.load_history().unwrap().wear.unwrap();
+        assert_eq!(w.law, solver::WearLaw::Archard { k: 0.0 });
+        assert_eq!(w.ball, Some(solver::WearLaw::Archard { k: 3e-6 * 1e-9 }));
+        let e = err(
+            &with(&format!("{fretting}\nwear = {{ law = \"archard\", k_mm3_per_nm = 1e-5, ball_alpha_mm3_per_j = 1e-6 }}")),
+            &[],
+        );
+        assert!(
+            e.contains("history.wear.ball_alpha_mm3_per_j: belongs to the other law"),
+            "{e}"
+        );
         // Without the key, no jump.
         let c = Config::parse(
             &with(&format!(

@@ -15,7 +15,7 @@ use std::path::Path;
 use super::plot::{self, err, Area, Figure, Frame, PALETTE};
 
 /// Header of `wear.csv`.
-pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime,worn_through_cells";
+pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime,worn_through_cells,ball_worn_volume_m3,ball_depth_max_m";
 
 /// Text of `wear.csv`.
 pub fn wear_csv(h: &HistoryOutput) -> String {
@@ -43,7 +43,14 @@ pub fn wear_csv(h: &HistoryOutput) -> String {
         for v in cells {
             let _ = write!(out, ",{}", fmt_f64(v));
         }
-        let _ = writeln!(out, ",{},{}", c.regime, c.worn_through_cells);
+        let _ = writeln!(
+            out,
+            ",{},{},{},{}",
+            c.regime,
+            c.worn_through_cells,
+            fmt_f64(c.ball_worn_volume_m3),
+            fmt_f64(c.ball_depth_max_m)
+        );
     }
     out
 }
@@ -249,7 +256,7 @@ mod tests {
         assert_eq!(lines.len(), 3);
         assert_eq!(lines[0], WEAR_HEADER);
         assert!(lines[2].starts_with("2,200,2e-15,"), "{}", lines[2]);
-        assert!(lines[2].ends_with(",partial,0"), "{}", lines[2]);
+        assert!(lines[2].ends_with(",partial,0,0,0"), "{}", lines[2]);
         assert_eq!(
             lines[0].split(',').count(),
             lines[2].split(',').count(),

@@ -148,8 +148,13 @@ pub struct LoadHistory {
 /// the cycles whose worn profiles are kept.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Wear {
-    /// The local law.
+    /// The substrate's local law.
     pub law: WearLaw,
+    /// The ball's, if it wears too (each body's worn depth is kept in its
+    /// own frame: the substrate moves under the ball by its shift);
+    /// `None`: it does not.
+    #[serde(default)]
+    pub ball: Option<WearLaw>,
     /// Cycle jumping: the physical cycles each simulated one stands for
     /// (each increment's wear is applied this many times, implicitly in
     /// the pressure; see `solve_history`), ≥ 1; 1: no jump.
@@ -170,10 +175,12 @@ fn no_jump() -> f64 {
 pub const MAX_WEAR_JUMP: f64 = 1e9;
 
 impl Wear {
-    /// A law without a jump, every profile but the last dropped.
+    /// A law for the substrate only, without a jump, every profile but the
+    /// last dropped.
     pub fn new(law: WearLaw) -> Self {
         Wear {
             law,
+            ball: None,
             jump: 1.0,
             save_every: 0,
         }
@@ -181,6 +188,9 @@ impl Wear {
 
     fn validate(&self) -> Result<(), SolverError> {
         self.law.validate()?;
+        if let Some(ball) = &self.ball {
+            ball.validate()?;
+        }
         if !(self.jump.is_finite() && (1.0..=MAX_WEAR_JUMP).contains(&self.jump)) {
             return Err(SolverError::invalid(
                 "history.wear.jump",

@@ -148,9 +148,15 @@ pub struct Fields {
     /// Permanent plastic penetration (the dent), m; empty on an elastic
     /// surface. Not one of [`Fields::named`]: sweeps do not carry it.
     pub plastic: Vec<f64>,
-    /// Worn depth over a load path with a wear law, m; empty without one.
-    /// Not one of [`Fields::named`] either.
+    /// The substrate's worn depth over a load path with a wear law, in its
+    /// own frame (the grid's cells at the path's start: at the ball's
+    /// shift δt the point under cell x is the one at x + δt), m; empty
+    /// without one. Not one of [`Fields::named`] either.
     pub wear: Vec<f64>,
+    /// The ball's worn depth per cell (the grid is the ball's frame: its
+    /// apex at the centre), m; empty unless the ball wears. Not one of
+    /// [`Fields::named`].
+    pub ball_wear: Vec<f64>,
 }
 
 impl Fields {
@@ -159,7 +165,11 @@ impl Fields {
     /// with a wear law.
     pub fn present(&self) -> Vec<(&'static str, &Vec<f64>)> {
         let mut all = self.named().to_vec();
-        for (name, v) in [("plastic", &self.plastic), ("wear", &self.wear)] {
+        for (name, v) in [
+            ("plastic", &self.plastic),
+            ("wear", &self.wear),
+            ("ball_wear", &self.ball_wear),
+        ] {
             if !v.is_empty() {
                 all.push((name, v));
             }
@@ -476,6 +486,7 @@ pub(crate) fn reduce(
         uz,
         plastic,
         wear: Vec::new(),
+        ball_wear: Vec::new(),
     };
     Ok(CaseOutput {
         scalars: s,

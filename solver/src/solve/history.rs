@@ -16,6 +16,8 @@ use crate::operators::operator::{X, Y, Z};
 use crate::solve::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::solve::normal::{NormalProblem, NormalSolution};
 use crate::solve::resident::Resident;
+use crate::solve::wear::{CycleRows, Wearing};
+pub use crate::solve::wear::{WearCycle, SCAR_DEFINITION, WEAR_JUMP_LIMIT};
 
 /// How the dissipated energy is computed.
 pub const DISSIPATION_DEFINITION: &str = "energy dissipated by slip, sum over increments and cells of (q_prev + q)/2 . (delta_t increment - u increment) dA, q the shear tractions and u the total tangential surface displacement (trapezoidal rule for the integral of q . ds, ds the slip increment of the substrate relative to the sphere); per cycle: over the last two segments that return to the same turning point";
@@ -115,66 +117,9 @@ pub struct HistoryOutput {
     /// ([`WearCycle::profile_x_m`] and `profile_y_m`) from the centre, m.
     #[serde(default)]
     pub wear_profile_at_m: Vec<f64>,
-}
-
-/// The largest depth one simulated cycle may wear, with its jump, as a
-/// fraction of the approach of the path's start, before
-/// [`HistoryOutput::wear_jump_ratio`] flags the jump. The error of a jump
-/// is first order in it; the MDR reference (bench/references) measured ~5 %
-/// on a worn partial-slip profile's transient at 1.5 % of the approach per
-/// cycle, and half that at half the jump.
-pub const WEAR_JUMP_LIMIT: f64 = 0.02;
-
-/// How a wear scar is delimited.
-pub const SCAR_DEFINITION: &str = "the cells worn deeper than 1 % of the largest worn depth; its area is their covered area, its extent along x (y) the distance between the outer edges of its outermost cells";
-
-/// Fraction of the largest worn depth that delimits the scar ([`SCAR_DEFINITION`]).
-const SCAR_FRACTION: f64 = 0.01;
-
-/// One simulated full cycle of a path with a wear law: the wear so far
-/// and the cycle's loop.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct WearCycle {
-    /// Simulated full cycles so far (1 for the first).
-    pub cycle: usize,
-    /// Physical cycles so far (`cycle` × the jump).
-    pub physical_cycles: f64,
-    /// Worn volume from the start of the path, m³.
-    pub worn_volume_m3: f64,
-    /// Volume worn per physical cycle over this simulated one, m³.
-    pub worn_volume_per_cycle_m3: f64,
-    /// Largest worn depth, m.
-    pub depth_max_m: f64,
-    /// Where it is (the cell's centre, x and y from the grid's centre), m.
-    pub depth_max_at_m: [f64; 2],
-    /// Largest depth worn over this simulated cycle (with its jump), m.
-    pub depth_increment_max_m: f64,
-    /// Area of the scar ([`SCAR_DEFINITION`]), m².
-    pub scar_area_m2: f64,
-    /// Extent of the scar along x and y, m.
-    pub scar_extent_m: [f64; 2],
-    /// Apparent contact radius at the cycle's end (`solver.radii`), m.
-    pub contact_radius_m: f64,
-    /// Smallest apparent stick radius over the cycle, m (0 in gross slip).
-    pub stick_radius_m: f64,
-    /// Force amplitude F* of the cycle, N.
-    pub force_amplitude_n: f64,
-    /// Shift amplitude δ* of the cycle, m.
-    pub shift_amplitude_m: f64,
-    /// Energy dissipated over the cycle, J.
-    pub dissipated_j: f64,
-    /// `partial` or `gross` ([`SLIP_REGIME_DEFINITION`]).
-    pub regime: String,
-    /// Cells of a pattern's islands worn deeper than the island stands
-    /// above the base (worn through: the pattern, and a cut cell's load on
-    /// its upper part, no longer describe them); 0 on a flat surface.
-    pub worn_through_cells: usize,
-    /// The worn depth along x through the contact's centre (the row
-    /// through it, the mean of the two next to it on an even grid), m; only
-    /// on saved cycles (`Wear::save_every` and the last), else empty.
-    pub profile_x_m: Vec<f64>,
-    /// The same along y.
-    pub profile_y_m: Vec<f64>,
+    /// With a wear law for the ball: its worn volume over the whole path, m³.
+    #[serde(default)]
+    pub ball_worn_volume_m3: Option<f64>,
 }
 
 /// How [`HistoryOutput::regime`] is decided.
@@ -217,6 +162,8 @@ pub(crate) struct HistoryState {
     pub turning: Vec<TurningState>,
     /// The worn depth per cell over the path, m (empty without wear).
     pub worn: Vec<f64>,
+    /// The ball's worn depth in its own frame, m (empty unless it wears).
+    pub ball_worn: Vec<f64>,
 }
 
 /// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
@@ -272,25 +219,13 @@ pub(crate) fn solve_history(
     // increment sees is the initial one plus the dent (unloading leaves it).
     // Worn depth likewise, with a wear law (the surface recedes).
     let mut dent = normal0.plastic.clone();
-    let wear = history.wear;
-    let mut worn: Vec<f64> = if wear.is_some() {
-        vec![0.0; len]
-    } else {
-        Vec::new()
-    };
-    // The increment's worn depth per cell (with a jump, its rate per Pa).
-    let mut dh = worn.clone();
-    // The worn depth at the start of the current cycle, and the cycles'
-    // records.
-    let mut worn_start = worn.clone();
-    let mut wear_cycles = Vec::new();
+    let mut wearing = history.wear.map(|w| Wearing::new(w, grid));
     let cycle_ends = full_cycles(&points);
     let cycles_total = cycle_ends.len();
-    let mut worn_volume = 0.0;
     // The separation h0 + dent + worn, rewritten in place after each
     // increment (`None`: h0 itself, no dent and no wear).
     let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
-    let mut dented: Option<Vec<f64>> = (!dent.is_empty() || wear.is_some())
+    let mut dented: Option<Vec<f64>> = (!dent.is_empty() || wearing.is_some())
         .then(|| (0..len).map(|i| h0[i] + at(&dent, i)).collect());
     let mut last = ContactState {
         p: normal0.p,
@@ -449,15 +384,31 @@ pub(crate) fn solve_history(
                 if mx != 0.0 || my != 0.0 {
                     work += mx * ds[0] + my * ds[1];
                 }
-                if let Some(w) = wear {
-                    let pm = 0.5 * (last.p[i] + state.p[i]);
-                    dh[i] = if pm > 0.0 {
-                        w.law.depth(pm, [mx, my], ds)
-                    } else {
-                        0.0
-                    };
+                if let Some(w) = &mut wearing {
+                    w.wear_cell(i, 0.5 * (last.p[i] + state.p[i]), [mx, my], ds);
                 }
             }
+            // With a wear law, the cells' slips δt − u halfway through the
+            // increment and at its end (where the substrate's worn points
+            // are).
+            let slips = wearing.as_ref().map(|_| {
+                let mid = |d: f64, s: f64, u0: &[f64], u1: &[f64]| -> Vec<f64> {
+                    (0..len)
+                        .map(|i| d + 0.5 * s - 0.5 * (u0[i] + u1[i]))
+                        .collect()
+                };
+                let end = |d: f64, u1: &[f64]| -> Vec<f64> { u1.iter().map(|u| d - u).collect() };
+                (
+                    (
+                        mid(delta_t[0], shift[0], &ux, &vx),
+                        mid(delta_t[1], shift[1], &uy, &vy),
+                    ),
+                    (
+                        end(delta_t[0] + shift[0], &vx),
+                        end(delta_t[1] + shift[1], &vy),
+                    ),
+                )
+            });
             delta_t = [delta_t[0] + shift[0], delta_t[1] + shift[1]];
             last_increment = shift[0].hypot(shift[1]);
             delta_t_max = delta_t_max.max(delta_t[0].hypot(delta_t[1]));
@@ -489,14 +440,21 @@ pub(crate) fn solve_history(
                     .zip(&state.plastic)
                     .for_each(|(d, w)| *d += w);
             }
-            let rewrite = |dented: &mut Option<Vec<f64>>, dent: &[f64], worn: &[f64]| {
-                if let Some(h) = dented {
-                    for (i, v) in h.iter_mut().enumerate() {
-                        *v = h0[i] + at(dent, i) + at(worn, i);
+            // The separation of what follows: h0 + dent + the worn depths
+            // (the substrate's at the points the slips brought under the
+            // cells).
+            let rewrite =
+                |dented: &mut Option<Vec<f64>>, dent: &[f64], wearing: &Option<Wearing>| {
+                    if let Some(h) = dented {
+                        for (i, v) in h.iter_mut().enumerate() {
+                            *v = h0[i] + at(dent, i);
+                        }
+                        if let (Some(w), Some((_, (sx, sy)))) = (wearing, &slips) {
+                            w.add_gap((sx, sy), h);
+                        }
                     }
-                }
-            };
-            if let Some(w) = wear {
+                };
+            if let (Some(w), Some(((mx, my), _))) = (&mut wearing, &slips) {
                 // The increment's wear, and the pressure on the worn surface
                 // (the next increment starts from it; at a constant load no
                 // other solve would see the wear without coupling).
@@ -507,19 +465,10 @@ pub(crate) fn solve_history(
                 // the normal solve, stable for any M (applied explicitly,
                 // M dh oscillates from cell to cell once cells are finer
                 // than ~0.03a, PHYSICS.md §5d).
-                let implicit = w.jump != 1.0;
-                if implicit {
-                    for (d, (&p0, &p1)) in dh.iter_mut().zip(last.p.iter().zip(&state.p)) {
-                        let pm = 0.5 * (p0 + p1);
-                        *d = if pm > 0.0 { w.jump * *d / pm } else { 0.0 };
-                    }
-                } else {
-                    for (i, &d) in dh.iter().enumerate() {
-                        worn[i] += d;
-                        worn_volume += d * da;
-                    }
-                }
-                rewrite(&mut dented, &dent, &worn);
+                w.prepare(&last.p, &state.p, (mx, my));
+            }
+            rewrite(&mut dented, &dent, &wearing);
+            if let (Some(w), Some(((mx, my), _))) = (&mut wearing, &slips) {
                 let mut hq = Vec::new();
                 if num.coupling {
                     hq = vec![0.0; len];
@@ -534,17 +483,11 @@ pub(crate) fn solve_history(
                     max_iterations: num.max_iterations,
                     p_init: Some(&state.p),
                     hardness: spec.limits().hardness,
-                    layer: implicit.then_some(&dh[..]),
+                    layer: w.layer(),
                     ..NormalProblem::new(dented.as_deref().unwrap_or(h0), p_k)
                 })?;
                 check(&worn_normal.p)?;
-                if implicit {
-                    for i in 0..len {
-                        let d = dh[i] * worn_normal.p[i];
-                        worn[i] += d;
-                        worn_volume += d * da;
-                    }
-                }
+                w.commit(&worn_normal.p, (mx, my));
                 if !worn_normal.plastic.is_empty() {
                     dent.iter_mut()
                         .zip(&worn_normal.plastic)
@@ -556,9 +499,9 @@ pub(crate) fn solve_history(
                 state.p = worn_normal.p;
                 state.approach = worn_normal.approach;
             }
-            rewrite(&mut dented, &dent, &worn);
+            rewrite(&mut dented, &dent, &wearing);
             converged &= step_converged;
-            r.worn_volume_m3 = worn_volume;
+            r.worn_volume_m3 = wearing.as_ref().map_or(0.0, |w| w.volume);
             rows.push(r);
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
@@ -566,20 +509,12 @@ pub(crate) fn solve_history(
         turning_steps.push(rows.len() - 1);
         turning.push(TurningState::of(rows.len() - 1, &last));
         let t = segment + 1;
-        if let (Some(w), true) = (wear, cycle_ends.contains(&t)) {
-            let number = wear_cycles.len() + 1;
-            let save = number == cycles_total || (w.save_every > 0 && number % w.save_every == 0);
-            wear_cycles.push(wear_cycle(
-                spec,
-                terrain,
-                &rows,
-                (turning_steps[t - 2], turning_steps[t]),
-                dir,
-                &last.p,
-                (&worn, &worn_start),
-                (w.jump, number, save),
-            ));
-            worn_start.clone_from(&worn);
+        if let (Some(w), true) = (&mut wearing, cycle_ends.contains(&t)) {
+            let number = w.cycles.len() + 1;
+            let every = w.settings().save_every;
+            let save = number == cycles_total || (every > 0 && number % every == 0);
+            let looped = cycle_rows(&rows, (turning_steps[t - 2], turning_steps[t]), dir);
+            w.record(spec, terrain, &last.p, &looped, save);
         }
     }
     // The final state's shift is δt from the start of the path, not the
@@ -590,22 +525,30 @@ pub(crate) fn solve_history(
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
-    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max, &worn);
-    let approach0 = output.steps[0].delta_z_m;
-    output.wear_jump_ratio = wear_cycles
-        .iter()
-        .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
-        .reduce(f64::max);
-    if wear.is_some() {
+    let worn = wearing.as_ref().map_or(&[][..], |w| &w.worn[..]);
+    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max, worn);
+    if let Some(w) = wearing.as_mut() {
+        let approach0 = output.steps[0].delta_z_m;
+        output.wear_jump_ratio = w
+            .cycles
+            .iter()
+            .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
+            .reduce(f64::max);
         output.wear_profile_at_m = (0..grid.n).map(|i| grid.x(i)).collect();
+        output.ball_worn_volume_m3 = w.settings().ball.map(|_| w.ball_volume);
+        output.wear_cycles = std::mem::take(&mut w.cycles);
     }
-    output.wear_cycles = wear_cycles;
+    let (worn, ball_worn) = match wearing {
+        Some(w) => (w.worn, w.ball),
+        None => (Vec::new(), Vec::new()),
+    };
     Ok(HistoryState {
         last,
         converged,
         output,
         turning,
         worn,
+        ball_worn,
     })
 }
 
@@ -638,16 +581,6 @@ fn full_cycles(points: &[(f64, f64)]) -> Vec<usize> {
 }
 
 /// What the rows of a full cycle (turning steps `s0` to `s1`) say.
-struct CycleRows {
-    /// Energy dissipated over it, J.
-    dissipated: f64,
-    /// The largest |F| and |δt| along the force direction, N and m.
-    force_amplitude: f64,
-    shift_amplitude: f64,
-    /// At some increment no contact cell sticks.
-    gross: bool,
-}
-
 fn cycle_rows(steps: &[HistoryStep], (s0, s1): (usize, usize), dir: [f64; 2]) -> CycleRows {
     let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
     let rows = &steps[s0..=s1];
@@ -664,108 +597,11 @@ fn cycle_rows(steps: &[HistoryStep], (s0, s1): (usize, usize), dir: [f64; 2]) ->
         gross: rows[1..]
             .iter()
             .any(|r| r.stick_area_m2 == 0.0 && r.contact_area_m2 > 0.0),
-    }
-}
-
-/// The record of a simulated full cycle (turning steps `s0`, `s1`) ending
-/// with pressure `p`: the worn depth `worn` (`start` at the cycle's
-/// start) and the cycle's rows; `(jump, cycle, save)`: the physical
-/// cycles per simulated one, its number, and whether to keep its profiles.
-#[allow(clippy::too_many_arguments)]
-fn wear_cycle(
-    spec: &CaseSpec,
-    terrain: &Terrain,
-    rows: &[HistoryStep],
-    (s0, s1): (usize, usize),
-    dir: [f64; 2],
-    p: &[f64],
-    (worn, start): (&[f64], &[f64]),
-    (jump, cycle, save): (f64, usize, bool),
-) -> WearCycle {
-    let grid = spec.grid;
-    let n = grid.n;
-    let looped = cycle_rows(rows, (s0, s1), dir);
-    let (mut deepest, mut depth_max) = (0, 0.0);
-    for (i, &d) in worn.iter().enumerate() {
-        if d > depth_max {
-            (deepest, depth_max) = (i, d);
-        }
-    }
-    let increment = worn
-        .iter()
-        .zip(start)
-        .map(|(a, b)| a - b)
-        .fold(0.0, f64::max);
-    let scar: Vec<bool> = worn
-        .iter()
-        .map(|&d| depth_max > 0.0 && d > SCAR_FRACTION * depth_max)
-        .collect();
-    let extent = |coord: &dyn Fn(usize) -> f64, spacing: f64| {
-        let (lo, hi) = (0..grid.len())
-            .filter(|&i| scar[i])
-            .map(coord)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-        if hi >= lo {
-            hi - lo + spacing
-        } else {
-            0.0
-        }
-    };
-    let contact: Vec<bool> = p.iter().map(|&v| v > 0.0).collect();
-    let base = terrain
-        .heights
-        .iter()
-        .cloned()
-        .fold(f64::INFINITY, f64::min);
-    let worn_through_cells = terrain
-        .heights
-        .iter()
-        .zip(worn)
-        .filter(|&(&z, &d)| z > base && d > z - base)
-        .count();
-    let stick_radius = rows[s0 + 1..=s1]
-        .iter()
-        .map(|r| r.stick_radius_m)
-        .fold(f64::INFINITY, f64::min);
-    // The cuts through the centre: the middle row (column), or the mean of
-    // the two next to the centre on an even grid.
-    let (lo, hi) = ((n - 1) / 2, n / 2);
-    let (profile_x_m, profile_y_m) = if save {
-        (
-            (0..n)
-                .map(|ix| 0.5 * (worn[lo * n + ix] + worn[hi * n + ix]))
-                .collect(),
-            (0..n)
-                .map(|iy| 0.5 * (worn[iy * n + lo] + worn[iy * n + hi]))
-                .collect(),
-        )
-    } else {
-        (Vec::new(), Vec::new())
-    };
-    WearCycle {
-        cycle,
-        physical_cycles: cycle as f64 * jump,
-        worn_volume_m3: rows[s1].worn_volume_m3,
-        worn_volume_per_cycle_m3: (rows[s1].worn_volume_m3 - rows[s0].worn_volume_m3) / jump,
-        depth_max_m: depth_max,
-        depth_max_at_m: [grid.x(deepest % n), grid.y(deepest / n)],
-        depth_increment_max_m: increment,
-        scar_area_m2: covered_area(&scar, terrain.cover.as_deref(), grid.cell_area()),
-        scar_extent_m: [
-            extent(&|i| grid.x(i % n), grid.dx),
-            extent(&|i| grid.y(i / n), grid.dy),
-        ],
-        contact_radius_m: apparent_radius(spec.numerics.radii, &grid, &contact, p, terrain),
-        stick_radius_m: if looped.gross { 0.0 } else { stick_radius },
-        force_amplitude_n: looped.force_amplitude,
-        shift_amplitude_m: looped.shift_amplitude,
-        dissipated_j: looped.dissipated,
-        regime: if looped.gross { "gross" } else { "partial" }.to_string(),
-        worn_through_cells,
-        profile_x_m,
-        profile_y_m,
+        stick_radius_min: rows[1..]
+            .iter()
+            .map(|r| r.stick_radius_m)
+            .fold(f64::INFINITY, f64::min),
+        worn_volume: (steps[s0].worn_volume_m3, steps[s1].worn_volume_m3),
     }
 }
 
@@ -930,5 +766,6 @@ fn reduce_history(
         wear_cycles: Vec::new(),
         wear_jump_ratio: None,
         wear_profile_at_m: Vec::new(),
+        ball_worn_volume_m3: None,
     }
 }

@@ -2,7 +2,8 @@
 //! solve's types, its momentum step, coarse start, window, its active-set
 //! iteration, the tangential solver and the imposed-shift variant; an
 //! operator with the caches those solvers made for it (`resident`); one
-//! load step with the coupling loop; a load history of steps.
+//! load step with the coupling loop; the wear of a path; a load history of
+//! steps.
 
 pub mod active_set;
 pub mod coarse_slip;
@@ -14,4 +15,5 @@ pub mod resident;
 pub mod tangential;
 pub mod tangential_displacement;
 pub mod tangential_problem;
+pub mod wear;
 pub mod window;
