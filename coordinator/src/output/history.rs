@@ -139,24 +139,9 @@ impl Figure for Hysteresis<'_> {
                 0 => BLACK,
                 c => PALETTE[c - 1],
             };
-            chart
-                .draw_series(LineSeries::new(
-                    line.iter().copied(),
-                    colour.stroke_width(2),
-                ))
-                .map_err(err)?
-                .label(label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+            plot::labelled_line(&mut chart, line, colour, label)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     }
 }
