@@ -104,7 +104,8 @@ impl Figure for MapFigure<'_> {
 }
 
 /// Writes `p.png`, `qx.png`, `qy.png`, `slip.png` and `stick.png` into `dir`
-/// (and `plastic.png`, the dent, on a surface with a hardness).
+/// (and `plastic.png`, the dent, on a surface with a hardness; `wear.png`
+/// and `ball_wear.png`, the worn depths, after a path with a wear law).
 /// `title` names the case (material, surface, ψ). Axes are x/a with a the
 /// apparent contact radius; tractions are normalised by the Hertz pressure p_H.
 pub fn write_maps(
@@ -171,6 +172,20 @@ pub fn write_maps(
             label: "plastic penetration (µm)",
             values: fields.plastic.iter().map(|w| w * 1e6).collect(),
         });
+    }
+    // After a path with a wear law: the worn depths, µm (the substrate's
+    // in its own frame, the ball's in the grid's).
+    for (file, label, worn) in [
+        ("wear.png", "worn depth (µm)", &fields.wear),
+        ("ball_wear.png", "ball worn (µm)", &fields.ball_wear),
+    ] {
+        if !worn.is_empty() {
+            maps.push(Map {
+                file,
+                label,
+                values: worn.iter().map(|w| w * 1e6).collect(),
+            });
+        }
     }
     let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
     for m in &maps {
