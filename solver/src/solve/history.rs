@@ -227,6 +227,9 @@ pub(crate) fn solve_history(
     let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(0.0);
     let mut dented: Option<Vec<f64>> = (!dent.is_empty() || wearing.is_some())
         .then(|| (0..len).map(|i| h0[i] + at(&dent, i)).collect());
+    // With a wear law: the normal contact on the surface the last
+    // increment wore, which the next starts from.
+    let mut worn_normal: Option<NormalSolution> = None;
     let mut last = ContactState {
         p: normal0.p,
         approach: normal0.approach,
@@ -295,11 +298,19 @@ pub(crate) fn solve_history(
             let h_now = dented.as_deref().unwrap_or(h0);
             // The normal solve at the new load, from the last pressure (with
             // coupling, under the last tractions' normal displacement).
+            // With a wear law, the pressure on the surface the last
+            // increment wore (the last state is the one its tractions were
+            // solved with); else the last pressure.
+            let on_worn = worn_normal.take();
             let normal = if p_k == p_prev {
+                let (p, approach) = match on_worn {
+                    Some(n) => (n.p, n.approach),
+                    None => (last.p.clone(), last.approach),
+                };
                 NormalSolution {
-                    p: last.p.clone(),
+                    p,
                     uz: Vec::new(),
-                    approach: last.approach,
+                    approach,
                     // Nothing new flows at an unchanged load.
                     plastic: Vec::new(),
                     report: crate::solve::normal::NormalReport {
@@ -345,7 +356,7 @@ pub(crate) fn solve_history(
             // new force. (Adding the force increment spread like the
             // pressure cost 7–9 % more iterations on Table 1a at 128².)
             let start = (&last.tangential.qx[..], &last.tangential.qy[..]);
-            let mut state = solve_step(
+            let state = solve_step(
                 res,
                 spec,
                 h_now,
@@ -418,22 +429,6 @@ pub(crate) fn solve_history(
             normal_iterations += state.normal_iterations;
             tangential_iterations += state.tangential_iterations;
             coupling_iterations += state.coupling_iterations;
-            let mut r = row(
-                spec,
-                terrain,
-                &state,
-                &StepSums {
-                    step: step_no,
-                    segment: segment + 1,
-                    delta_t,
-                    dissipated: work * da,
-                    converged: step_converged,
-                },
-            );
-            if !displacement_control {
-                let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
-                force_error_max = force_error_max.max(ferr);
-            }
             (ux, uy) = (vx, vy);
             if !state.plastic.is_empty() {
                 dent.iter_mut()
@@ -477,7 +472,7 @@ pub(crate) fn solve_history(
                         &mut [(Z, &mut hq)],
                     );
                 }
-                let worn_normal = res.solve_normal(&NormalProblem {
+                let solved = res.solve_normal(&NormalProblem {
                     extra_gap: num.coupling.then_some(&hq[..]),
                     tolerance: num.tolerance,
                     max_iterations: num.max_iterations,
@@ -486,21 +481,38 @@ pub(crate) fn solve_history(
                     layer: w.layer(),
                     ..NormalProblem::new(dented.as_deref().unwrap_or(h0), p_k)
                 })?;
-                check(&worn_normal.p)?;
-                w.commit(&worn_normal.p, (mx, my));
-                if !worn_normal.plastic.is_empty() {
+                check(&solved.p)?;
+                w.commit(&solved.p, (mx, my));
+                if !solved.plastic.is_empty() {
                     dent.iter_mut()
-                        .zip(&worn_normal.plastic)
+                        .zip(&solved.plastic)
                         .for_each(|(d, w)| *d += w);
                 }
-                normal_iterations += worn_normal.report.iterations;
-                step_converged &= worn_normal.report.converged;
-                r.converged = step_converged;
-                state.p = worn_normal.p;
-                state.approach = worn_normal.approach;
+                normal_iterations += solved.report.iterations;
+                step_converged &= solved.report.converged;
+                worn_normal = Some(solved);
             }
             rewrite(&mut dented, &dent, &wearing);
             converged &= step_converged;
+            // The row: the increment's state, on the worn surface with a
+            // wear law (the pressure the next increment starts from, which
+            // the case's final scalars reduce too).
+            let mut r = row(
+                spec,
+                terrain,
+                &state,
+                &StepSums {
+                    step: step_no,
+                    segment: segment + 1,
+                    delta_t,
+                    dissipated: work * da,
+                    converged: step_converged,
+                },
+            );
+            if !displacement_control {
+                let ferr = (r.force_n[0] - goal[0]).hypot(r.force_n[1] - goal[1]) / (mu * p_k);
+                force_error_max = force_error_max.max(ferr);
+            }
             r.worn_volume_m3 = wearing.as_ref().map_or(0.0, |w| w.volume);
             rows.push(r);
             last = state;

@@ -319,9 +319,15 @@ impl Wearing {
             worn_volume_m3: v1,
             worn_volume_per_cycle_m3: (v1 - v0) / jump,
             depth_max_m: depth_max,
-            depth_max_at_m: [grid.x(deepest % n), grid.y(deepest / n)],
+            // (Nothing worn: the centre.)
+            depth_max_at_m: if depth_max > 0.0 {
+                [grid.x(deepest % n), grid.y(deepest / n)]
+            } else {
+                [0.0; 2]
+            },
             depth_increment_max_m: increment,
-            scar_area_m2: covered_area(&scar, terrain.cover.as_deref(), grid.cell_area()),
+            // (+ 0.0: an empty sum is −0.)
+            scar_area_m2: covered_area(&scar, terrain.cover.as_deref(), grid.cell_area()) + 0.0,
             scar_extent_m: [
                 extent(&|i| grid.x(i % n), grid.dx),
                 extent(&|i| grid.y(i / n), grid.dy),
