@@ -245,6 +245,11 @@ fn a_cycle_jump_converges_at_first_order() {
             // The records agree with the path's totals and the field.
             assert_eq!(hist.wear_cycles.len(), cycles);
             assert_eq!(Some(last.worn_volume_m3), hist.worn_volume_m3);
+            // Both per physical cycle.
+            assert_eq!(
+                Some(last.worn_volume_per_cycle_m3),
+                hist.worn_volume_per_cycle_m3
+            );
             let deepest = out.fields.wear.iter().cloned().fold(0.0, f64::max);
             assert_eq!(last.depth_max_m, deepest);
             let per_cycle: f64 = hist

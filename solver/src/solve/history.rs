@@ -97,7 +97,9 @@ pub struct HistoryOutput {
     /// With a wear law: the volume worn over the whole path, m³.
     #[serde(default)]
     pub worn_volume_m3: Option<f64>,
-    /// With a wear law: the volume worn over the last full cycle, m³.
+    /// With a wear law: the volume worn over the last full cycle, per
+    /// physical cycle (with a cycle jump M, the simulated cycle's over
+    /// M), m³.
     #[serde(default)]
     pub worn_volume_per_cycle_m3: Option<f64>,
     /// With a wear law: the largest worn depth, m.
@@ -548,6 +550,8 @@ pub(crate) fn solve_history(
             .reduce(f64::max);
         output.wear_profile_at_m = (0..grid.n).map(|i| grid.x(i)).collect();
         output.ball_worn_volume_m3 = w.settings().ball.map(|_| w.ball_volume);
+        let jump = w.settings().jump;
+        output.worn_volume_per_cycle_m3 = output.worn_volume_per_cycle_m3.map(|v| v / jump);
         output.wear_cycles = std::mem::take(&mut w.cycles);
     }
     let (worn, ball_worn) = match wearing {
