@@ -32,10 +32,10 @@ pub const CASE_EXPONENT: f64 = 2.35;
 const INCREMENT_COST: f64 = 0.6;
 
 /// With a wear law each increment adds a normal solve on the worn surface:
-/// about 0.11 of a coupled monotonic solve, with coupling or without
-/// (bench/wear.sh at 256² of 1.25 µm: 0.055 s and 0.048 s an increment
-/// against a coupled monotonic solve's 0.45 s).
-const WEAR_INCREMENT_COST: f64 = 0.11;
+/// about 0.09 of a coupled monotonic solve without coupling, nothing
+/// measurable with it (bench/wear.sh at 256² of 1.25 µm, 3f916f7: 0.040 s
+/// an increment uncoupled against a coupled monotonic solve's 0.44 s).
+const WEAR_INCREMENT_COST: f64 = 0.09;
 
 /// A case on a surface with a hardness costs about 2.5 elastic ones: the
 /// paper's Table 1(c) surfaces at 512² took 2.0–2.1× the elastic sweep's

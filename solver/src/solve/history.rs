@@ -464,7 +464,9 @@ pub(crate) fn solve_history(
                 // than ~0.03a, PHYSICS.md §5d).
                 w.prepare(&last.p, &state.p, (mx, my));
             }
-            rewrite(&mut dented, &dent, &wearing);
+            if wearing.is_some() {
+                rewrite(&mut dented, &dent, &wearing);
+            }
             if let (Some(w), Some(((mx, my), _))) = (&mut wearing, &slips) {
                 let mut hq = Vec::new();
                 if num.coupling {
@@ -496,9 +498,8 @@ pub(crate) fn solve_history(
             }
             rewrite(&mut dented, &dent, &wearing);
             converged &= step_converged;
-            // The row: the increment's state, on the worn surface with a
-            // wear law (the pressure the next increment starts from, which
-            // the case's final scalars reduce too).
+            // The row: the state the increment solved (with a wear law,
+            // before its own wear, which the next increment starts from).
             let mut r = row(
                 spec,
                 terrain,
