@@ -85,10 +85,8 @@ class Result:
             return None
         import numpy as np
 
-        steps = h["steps"]
-
         def col(get, dtype=np.float64):
-            return np.array([get(r) for r in steps], dtype=dtype)
+            return _table_column(h["steps"], get, dtype)
 
         table = {
             "step": col(lambda r: r["step"], np.int64),
@@ -125,10 +123,8 @@ class Result:
             return None
         import numpy as np
 
-        cycles = h["wear_cycles"]
-
         def col(get, dtype=np.float64):
-            return np.array([get(c) for c in cycles], dtype=dtype)
+            return _table_column(h["wear_cycles"], get, dtype)
 
         return {
             "cycle": col(lambda c: c["cycle"], np.int64),
@@ -177,6 +173,13 @@ class Result:
             f"a = {s['contact_radius_m']:.4e} m, c = {s['stick_radius_m']:.4e} m, "
             f"mu_a = {s['mu_a']}, status = {s['status']})"
         )
+
+
+def _table_column(rows, get, dtype):
+    """The 1-D array of ``get(row)`` over ``rows`` (a table's column)."""
+    import numpy as np
+
+    return np.array([get(r) for r in rows], dtype=dtype)
 
 
 def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
