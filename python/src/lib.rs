@@ -440,6 +440,14 @@ fn solve<'py>(
     for (name, data) in solved.fields.present() {
         fields.set_item(name, PyArray1::from_slice(py, data).reshape([n, n])?)?;
     }
+    // With a wear law: the worn depth at the saved cycles, named as the
+    // CLI's files.
+    for (cycle, data) in &solved.fields.wear_saved {
+        fields.set_item(
+            format!("wear_cycle_{cycle}"),
+            PyArray1::from_slice(py, data).reshape([n, n])?,
+        )?;
+    }
     // With [stress]: the arrays of the CLI's stress/*.npy, by file stem.
     let stress = match &solved.stress {
         Some(so) => {

@@ -256,6 +256,11 @@ def test_wear_along_a_fretting_path_equals_the_cli(tmp_path, cli_solve):
     assert at.tobytes() == cli[:, 0].tobytes()
     assert saved[1][0].tobytes() == cli[:, 1].tobytes()
     assert saved[1][1].tobytes() == cli[:, 2].tobytes()
+    # The worn depth at the saved cycle, as the CLI's file (the last: the
+    # final field).
+    saved_field = res.fields["wear_cycle_1"]
+    assert saved_field.tobytes() == np.load(cli_dir / "wear_cycle_1.npy").tobytes()
+    assert saved_field.tobytes() == depth.tobytes()
     # The cut along x through the centre of the even grid: the mean of the
     # two middle rows.
     n = depth.shape[0]

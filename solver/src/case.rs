@@ -106,5 +106,6 @@ fn solve_history_case(
     out.turning = turning;
     out.fields.wear = solved.worn;
     out.fields.ball_wear = solved.ball_worn;
+    out.fields.wear_saved = solved.worn_saved;
     Ok(out)
 }

@@ -8,6 +8,7 @@
 use anyhow::Result;
 use plotters::prelude::*;
 use solver::{CaseScalars, Fields};
+use std::borrow::Cow;
 use std::path::Path;
 
 use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame};
@@ -19,8 +20,8 @@ const MAP_WIDTH: u32 = 620;
 
 /// One map: `values` (n x n, row-major [iy][ix]) drawn over |x|, |y| ≤ extent·a.
 struct Map<'a> {
-    file: &'a str,
-    label: &'a str,
+    file: Cow<'a, str>,
+    label: Cow<'a, str>,
     values: Vec<f64>,
 }
 
@@ -99,7 +100,7 @@ impl Figure for MapFigure<'_> {
                 })
             }))
             .map_err(err)?;
-        colour_bar(&bar, map.label, lo, hi)
+        colour_bar(&bar, &map.label, lo, hi)
     }
 }
 
@@ -139,28 +140,28 @@ pub fn write_maps(
         .collect();
     let mut maps = vec![
         Map {
-            file: "p.png",
-            label: "p / p_H",
+            file: "p.png".into(),
+            label: "p / p_H".into(),
             values: norm(&fields.p),
         },
         Map {
-            file: "qx.png",
-            label: "qx / p_H",
+            file: "qx.png".into(),
+            label: "qx / p_H".into(),
             values: norm(&fields.qx),
         },
         Map {
-            file: "qy.png",
-            label: "qy / p_H",
+            file: "qy.png".into(),
+            label: "qy / p_H".into(),
             values: norm(&fields.qy),
         },
         Map {
-            file: "slip.png",
-            label: "|s| (µm)",
+            file: "slip.png".into(),
+            label: "|s| (µm)".into(),
             values: slip,
         },
         Map {
-            file: "stick.png",
-            label: "0 free, 1 slip, 2 stick",
+            file: "stick.png".into(),
+            label: "0 free, 1 slip, 2 stick".into(),
             values: status,
         },
     ];
@@ -168,8 +169,8 @@ pub fn write_maps(
     // penetration), µm.
     if !fields.plastic.is_empty() {
         maps.push(Map {
-            file: "plastic.png",
-            label: "plastic penetration (µm)",
+            file: "plastic.png".into(),
+            label: "plastic penetration (µm)".into(),
             values: fields.plastic.iter().map(|w| w * 1e6).collect(),
         });
     }
@@ -181,15 +182,23 @@ pub fn write_maps(
     ] {
         if !worn.is_empty() {
             maps.push(Map {
-                file,
-                label,
+                file: file.into(),
+                label: label.into(),
                 values: worn.iter().map(|w| w * 1e6).collect(),
             });
         }
     }
+    // And at the saved cycles (the last is `wear.png`'s).
+    for (cycle, worn) in &fields.wear_saved {
+        maps.push(Map {
+            file: format!("wear_cycle_{cycle}.png").into(),
+            label: format!("worn depth, simulated cycle {cycle} (µm)").into(),
+            values: worn.iter().map(|w| w * 1e6).collect(),
+        });
+    }
     let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
     for m in &maps {
-        let path = dir.join(m.file);
+        let path = dir.join(m.file.as_ref());
         let label = format!("{title}: {}", m.label);
         let figure = MapFigure {
             title: &label,

@@ -36,5 +36,8 @@ pub fn write_fields(dir: &Path, fields: &Fields) -> Result<()> {
     for (name, data) in fields.present() {
         write_npy(&dir.join(format!("{name}.npy")), fields.n, data)?;
     }
+    for (cycle, data) in &fields.wear_saved {
+        write_npy(&dir.join(format!("wear_cycle_{cycle}.npy")), fields.n, data)?;
+    }
     Ok(())
 }

@@ -157,6 +157,10 @@ pub struct Fields {
     /// apex at the centre), m; empty unless the ball wears. Not one of
     /// [`Fields::named`].
     pub ball_wear: Vec<f64>,
+    /// The substrate's worn depth at the cycles a wear law saves
+    /// (`Wear::save_every` and the last), with their numbers, m; written by
+    /// `solve` as `wear_cycle_K.npy`. Not one of [`Fields::named`].
+    pub wear_saved: Vec<(usize, Vec<f64>)>,
 }
 
 impl Fields {
@@ -487,6 +491,7 @@ pub(crate) fn reduce(
         plastic,
         wear: Vec::new(),
         ball_wear: Vec::new(),
+        wear_saved: Vec::new(),
     };
     Ok(CaseOutput {
         scalars: s,

@@ -166,6 +166,8 @@ pub(crate) struct HistoryState {
     pub worn: Vec<f64>,
     /// The ball's worn depth in its own frame, m (empty unless it wears).
     pub ball_worn: Vec<f64>,
+    /// The substrate's worn depth at the saved cycles (their numbers), m.
+    pub worn_saved: Vec<(usize, Vec<f64>)>,
 }
 
 /// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
@@ -555,9 +557,9 @@ pub(crate) fn solve_history(
         output.worn_volume_per_cycle_m3 = output.worn_volume_per_cycle_m3.map(|v| v / jump);
         output.wear_cycles = std::mem::take(&mut w.cycles);
     }
-    let (worn, ball_worn) = match wearing {
-        Some(w) => (w.worn, w.ball),
-        None => (Vec::new(), Vec::new()),
+    let (worn, ball_worn, worn_saved) = match wearing {
+        Some(w) => (w.worn, w.ball, w.saved),
+        None => (Vec::new(), Vec::new(), Vec::new()),
     };
     Ok(HistoryState {
         last,
@@ -566,6 +568,7 @@ pub(crate) fn solve_history(
         turning,
         worn,
         ball_worn,
+        worn_saved,
     })
 }
 

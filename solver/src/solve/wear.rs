@@ -119,6 +119,8 @@ pub(crate) struct Wearing {
     start: Vec<f64>,
     /// The simulated cycles' records.
     pub cycles: Vec<WearCycle>,
+    /// The substrate's worn depth at the saved cycles (their numbers).
+    pub saved: Vec<(usize, Vec<f64>)>,
 }
 
 impl Wearing {
@@ -138,6 +140,7 @@ impl Wearing {
             ball_volume: 0.0,
             start: vec![0.0; len],
             cycles: Vec::new(),
+            saved: Vec::new(),
         }
     }
 
@@ -349,6 +352,9 @@ impl Wearing {
             profile_y_m,
         };
         self.cycles.push(record);
+        if save {
+            self.saved.push((cycle, self.worn.clone()));
+        }
         self.start.clone_from(&self.worn);
     }
 }
