@@ -1938,3 +1938,63 @@ fn issue34_moment_radii_change_the_radii_and_mu_a_only() {
     }
     assert!(moved > 0, "no patterned μa moved");
 }
+
+#[test]
+fn a_worn_sweep_resumes_to_the_same_curves_and_wear_tables() {
+    // Issue #49: a sweep with a wear law interrupted after a few cases and
+    // resumed gives the curves (worn volume and depth against the angle)
+    // and every case's wear.csv of the uninterrupted sweep.
+    let dir = scratch("resume-wear");
+    let worn = format!(
+        "{CONFIG}\n[history]\nfretting = {{ amplitude_ratio = 0.6, cycles = 2 }}\nsteps_per_segment = 3\nwear = {{ law = \"archard\", k_mm3_per_nm = 1e-4, physical_cycles = 200 }}\n"
+    );
+    std::fs::write(dir.join("sweep.toml"), worn).unwrap();
+    check_ok(
+        &sweep_cmd(&dir, "full", 2, "w").output().unwrap(),
+        "full sweep",
+    );
+    check_ok(&sweep_cmd(&dir, "out", 2, "w").output().unwrap(), "sweep");
+    let (full, o) = (dir.join("full"), dir.join("out"));
+    let text = std::fs::read_to_string(o.join("journal.jsonl")).unwrap();
+    let kept: Vec<&str> = text.lines().take(4).collect();
+    let kept_cases = kept
+        .iter()
+        .filter(|l| l.contains("\"kind\":\"case\""))
+        .count();
+    assert!(kept_cases >= 2, "{text}");
+    std::fs::write(o.join("journal.jsonl"), kept.join("\n") + "\n").unwrap();
+    for f in ["results.csv", "curves.csv", "summary.json"] {
+        std::fs::remove_file(o.join(f)).unwrap();
+    }
+    let mut c = sweep_cmd(&dir, "out", 2, "w");
+    c.arg("--resume");
+    check_ok(&c.output().unwrap(), "resume");
+    assert_eq!(summary(&o)["resumed"], kept_cases);
+    let curves = std::fs::read_to_string(o.join("curves.csv")).unwrap();
+    assert!(curves
+        .lines()
+        .next()
+        .unwrap()
+        .contains("worn_volume_m3,worn_depth_max_m"));
+    assert_eq!(
+        curves,
+        std::fs::read_to_string(full.join("curves.csv")).unwrap()
+    );
+    let mut tables = 0;
+    for m in ["Cu", "Ni"] {
+        for s in ["flat", "circle-A"] {
+            for a in ["000.0", "045.0", "090.0"] {
+                let case = Path::new("fields").join(m).join(s).join(a).join("wear.csv");
+                assert_eq!(
+                    std::fs::read(o.join(&case)).unwrap(),
+                    std::fs::read(full.join(&case)).unwrap(),
+                    "{}",
+                    case.display()
+                );
+                tables += 1;
+            }
+        }
+    }
+    assert_eq!(tables, CASES);
+    assert!(shm_leftovers("w").is_empty());
+}
