@@ -297,7 +297,7 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
     let c = &solved.case;
     let title = format!("{}, {}, ψ = {}°", c.material, c.surface, c.angle_deg);
     if let Some(h) = &solved.scalars.history {
-        for w in crate::output::history::write_history(out, h, &title)? {
+        for w in crate::output::history::write_history(out, h, &c.spec.grid, &title)? {
             eprintln!("warning: {w}");
         }
     }

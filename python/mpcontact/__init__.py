@@ -164,7 +164,7 @@ class Result:
             for c in h["wear_cycles"]
             if c["profile_x_m"]
         }
-        return np.array(h["wear_profile_at_m"]), saved
+        return self.coordinates_m()[0], saved
 
     def __repr__(self):
         s = self.scalars

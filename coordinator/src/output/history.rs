@@ -6,7 +6,7 @@
 use crate::float_text::fmt_f64;
 use anyhow::Result;
 use plotters::prelude::*;
-use solver::HistoryOutput;
+use solver::{Grid, HistoryOutput};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -150,7 +150,12 @@ impl Figure for Hysteresis<'_> {
 /// and with a wear law the files of [`super::wear::write_wear`].
 /// The table is written first; a picture that cannot be drawn is returned
 /// as a warning, not an error.
-pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
+pub fn write_history(
+    dir: &Path,
+    h: &HistoryOutput,
+    grid: &Grid,
+    title: &str,
+) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir)?;
     super::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
     let mut warnings = Vec::new();
@@ -159,7 +164,7 @@ pub fn write_history(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<S
             warnings.push(format!("{name}: {e:#}"));
         }
     }
-    warnings.extend(super::wear::write_wear(dir, h, title)?);
+    warnings.extend(super::wear::write_wear(dir, h, grid, title)?);
     warnings.extend(
         super::wear::wear_warnings(h)
             .into_iter()

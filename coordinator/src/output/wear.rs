@@ -8,7 +8,7 @@
 use crate::float_text::fmt_f64;
 use anyhow::Result;
 use plotters::prelude::*;
-use solver::{HistoryOutput, WearCycle};
+use solver::{Grid, HistoryOutput, WearCycle};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -63,17 +63,17 @@ fn saved(h: &HistoryOutput) -> Vec<&WearCycle> {
         .collect()
 }
 
-/// Text of `wear_profiles.csv`: the position from the centre, then per
-/// saved cycle its depth along x and along y.
-pub fn profiles_csv(h: &HistoryOutput) -> String {
+/// Text of `wear_profiles.csv` on the case's `grid`: the position from the
+/// centre, then per saved cycle its depth along x and along y.
+pub fn profiles_csv(h: &HistoryOutput, grid: &Grid) -> String {
     let cycles = saved(h);
     let mut out = String::from("position_m");
     for c in &cycles {
         let _ = write!(out, ",x_cycle_{0},y_cycle_{0}", c.cycle);
     }
     out.push('\n');
-    for (i, &at) in h.wear_profile_at_m.iter().enumerate() {
-        out.push_str(&fmt_f64(at));
+    for i in 0..grid.n {
+        out.push_str(&fmt_f64(grid.x(i)));
         for c in &cycles {
             let _ = write!(
                 out,
@@ -97,12 +97,11 @@ struct Profiles<'a> {
     title: &'a str,
 }
 
-fn profile_lines(h: &HistoryOutput) -> Vec<ProfileLine> {
+fn profile_lines(h: &HistoryOutput, grid: &Grid) -> Vec<ProfileLine> {
     let line = |p: &[f64]| -> Vec<(f64, f64)> {
-        h.wear_profile_at_m
-            .iter()
-            .zip(p)
-            .map(|(&x, &d)| (x * 1e6, -d * 1e6))
+        p.iter()
+            .enumerate()
+            .map(|(i, &d)| (grid.x(i) * 1e6, -d * 1e6))
             .collect()
     };
     saved(h)
@@ -168,15 +167,18 @@ impl Figure for Profiles<'_> {
 /// `dir` when the path wore the surface (nothing otherwise). The tables
 /// are written first; a picture that cannot be drawn is returned as a
 /// warning, not an error.
-pub fn write_wear(dir: &Path, h: &HistoryOutput, title: &str) -> Result<Vec<String>> {
+pub fn write_wear(dir: &Path, h: &HistoryOutput, grid: &Grid, title: &str) -> Result<Vec<String>> {
     if h.wear_cycles.is_empty() {
         return Ok(Vec::new());
     }
     std::fs::create_dir_all(dir)?;
     super::atomic::write(&dir.join("wear.csv"), wear_csv(h).as_bytes())?;
-    super::atomic::write(&dir.join("wear_profiles.csv"), profiles_csv(h).as_bytes())?;
+    super::atomic::write(
+        &dir.join("wear_profiles.csv"),
+        profiles_csv(h, grid).as_bytes(),
+    )?;
     let figure = Profiles {
-        lines: profile_lines(h),
+        lines: profile_lines(h, grid),
         title,
     };
     let mut warnings = Vec::new();
@@ -227,7 +229,6 @@ mod tests {
         };
         HistoryOutput {
             wear_cycles: vec![cycle(1, false), cycle(2, true)],
-            wear_profile_at_m: vec![-1e-6, 0.0, 1e-6],
             wear_jump_ratio: Some(0.05),
             ..Default::default()
         }
@@ -247,7 +248,7 @@ mod tests {
             lines[2].split(',').count(),
             "a value per column"
         );
-        let profiles = profiles_csv(&h);
+        let profiles = profiles_csv(&h, &Grid::square(3, 1e-6));
         let rows: Vec<&str> = profiles.lines().collect();
         assert_eq!(rows[0], "position_m,x_cycle_2,y_cycle_2");
         assert_eq!(rows[2], "0,2e-8,1e-8");

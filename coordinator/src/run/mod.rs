@@ -291,7 +291,7 @@ fn write_outputs(
         if let Some(a) = key.amplitude_um {
             title.push_str(&format!(", Δ = {a} µm"));
         }
-        match history::write_history(&sweep::fields_dir(dir, key), h, &title) {
+        match history::write_history(&sweep::fields_dir(dir, key), h, &r.spec.grid, &title) {
             Ok(warnings) => summary.output_warnings.extend(warnings),
             Err(e) => summary
                 .output_warnings

@@ -115,10 +115,6 @@ pub struct HistoryOutput {
     /// profile's transient.
     #[serde(default)]
     pub wear_jump_ratio: Option<f64>,
-    /// With a wear law: the positions of the points of the worn profiles
-    /// ([`WearCycle::profile_x_m`] and `profile_y_m`) from the centre, m.
-    #[serde(default)]
-    pub wear_profile_at_m: Vec<f64>,
     /// With a wear law for the ball: its worn volume over the whole path, m³.
     #[serde(default)]
     pub ball_worn_volume_m3: Option<f64>,
@@ -551,7 +547,6 @@ pub(crate) fn solve_history(
             .iter()
             .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
             .reduce(f64::max);
-        output.wear_profile_at_m = (0..grid.n).map(|i| grid.x(i)).collect();
         output.ball_worn_volume_m3 = w.settings().ball.map(|_| w.ball_volume);
         let jump = w.settings().jump;
         output.worn_volume_per_cycle_m3 = output.worn_volume_per_cycle_m3.map(|v| v / jump);
@@ -785,7 +780,6 @@ fn reduce_history(
         worn_depth_max_m: worn_depth_max,
         wear_cycles: Vec::new(),
         wear_jump_ratio: None,
-        wear_profile_at_m: Vec::new(),
         ball_worn_volume_m3: None,
     }
 }

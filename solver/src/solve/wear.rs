@@ -73,8 +73,9 @@ pub struct WearCycle {
     /// The ball's largest worn depth, m.
     pub ball_depth_max_m: f64,
     /// The worn depth along x through the contact's centre (the row
-    /// through it, the mean of the two next to it on an even grid), m; only
-    /// on saved cycles (`Wear::save_every` and the last), else empty.
+    /// through it, the mean of the two next to it on an even grid; point i
+    /// at the grid's x(i)), m; only on saved cycles (`Wear::save_every` and
+    /// the last), else empty.
     pub profile_x_m: Vec<f64>,
     /// The same along y.
     pub profile_y_m: Vec<f64>,
