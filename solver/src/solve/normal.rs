@@ -127,12 +127,17 @@ impl<Z: ZzApply> ZzApply for Layered<'_, Z> {
     }
     fn apply_zz(&mut self, p: &[f64], uz: &mut [f64]) {
         self.inner.apply_zz(p, uz);
-        for ((u, &pi), &c) in uz.iter_mut().zip(p).zip(self.layer) {
-            *u += c * pi;
-        }
+        add_layer(self.layer, p, uz);
     }
     fn precondition(&mut self, g: &[f64], active: &[bool], z: &mut [f64]) {
         self.inner.precondition(g, active, z);
+    }
+}
+
+/// Adds the compression `c p` of a compliant layer `c` to `uz`.
+fn add_layer(layer: &[f64], p: &[f64], uz: &mut [f64]) {
+    for ((u, &pi), &c) in uz.iter_mut().zip(p).zip(layer) {
+        *u += c * pi;
     }
 }
 
@@ -889,9 +894,7 @@ pub fn solve_normal(
     // Final state and residuals from the returned pressure.
     op.normal(&p, &mut u);
     if let Some(layer) = layer {
-        for ((u, &pi), &c) in u.iter_mut().zip(&p).zip(layer) {
-            *u += c * pi;
-        }
+        add_layer(layer, &p, &mut u);
     }
     // The approach is the gap of the cells in elastic contact (below their
     // caps); with every contact cell capped, the largest capped gap.
