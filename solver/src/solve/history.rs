@@ -430,7 +430,11 @@ pub(crate) fn solve_history(
             tangential_iterations += state.tangential_iterations;
             coupling_iterations += state.coupling_iterations;
             (ux, uy) = (vx, vy);
-            if !state.plastic.is_empty() {
+            // Whether the separation must be rewritten below: the dent
+            // grew, or (with a wear law, whose substrate moves with the
+            // slips) always.
+            let mut moved = !state.plastic.is_empty();
+            if moved {
                 dent.iter_mut()
                     .zip(&state.plastic)
                     .for_each(|(d, w)| *d += w);
@@ -464,6 +468,7 @@ pub(crate) fn solve_history(
             }
             if wearing.is_some() {
                 rewrite(&mut dented, &dent, &wearing);
+                moved = false;
             }
             if let (Some(w), Some(((mx, my), _))) = (&mut wearing, &slips) {
                 let mut hq = Vec::new();
@@ -485,6 +490,7 @@ pub(crate) fn solve_history(
                 })?;
                 check(&solved.p)?;
                 w.commit(&solved.p, (mx, my));
+                moved = w.implicit() || !solved.plastic.is_empty();
                 if !solved.plastic.is_empty() {
                     dent.iter_mut()
                         .zip(&solved.plastic)
@@ -494,7 +500,9 @@ pub(crate) fn solve_history(
                 step_converged &= solved.report.converged;
                 worn_normal = Some(solved);
             }
-            rewrite(&mut dented, &dent, &wearing);
+            if moved {
+                rewrite(&mut dented, &dent, &wearing);
+            }
             converged &= step_converged;
             // The row: the state the increment solved (with a wear law,
             // before its own wear, which the next increment starts from).
@@ -538,8 +546,8 @@ pub(crate) fn solve_history(
     last.normal_iterations = normal_iterations;
     last.tangential_iterations = tangential_iterations;
     last.coupling_iterations = coupling_iterations;
-    let worn = wearing.as_ref().map_or(&[][..], |w| &w.worn[..]);
-    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max, worn);
+    let wear = wearing.as_ref().map(|w| (&w.worn[..], w.settings().jump));
+    let mut output = reduce_history(dir, rows, &points, turning_steps, force_error_max, wear);
     if let Some(w) = wearing.as_mut() {
         let approach0 = output.steps[0].delta_z_m;
         output.wear_jump_ratio = w
@@ -548,8 +556,6 @@ pub(crate) fn solve_history(
             .map(|c| c.depth_increment_max_m / approach0.abs().max(f64::MIN_POSITIVE))
             .reduce(f64::max);
         output.ball_worn_volume_m3 = w.settings().ball.map(|_| w.ball_volume);
-        let jump = w.settings().jump;
-        output.worn_volume_per_cycle_m3 = output.worn_volume_per_cycle_m3.map(|v| v / jump);
         output.wear_cycles = std::mem::take(&mut w.cycles);
     }
     let (worn, ball_worn, worn_saved) = match wearing {
@@ -666,14 +672,14 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
 }
 
 /// The cycle, reversal and residual-shift reductions of a solved path, and
-/// with a wear law (`worn`, the worn depth, not empty) its wear.
+/// with a wear law (`wear`: the worn depth and the cycle jump) its wear.
 fn reduce_history(
     dir: [f64; 2],
     steps: Vec<HistoryStep>,
     points: &[(f64, f64)],
     turning_steps: Vec<usize>,
     force_error_max: f64,
-    worn: &[f64],
+    wear: Option<(&[f64], f64)>,
 ) -> HistoryOutput {
     let along = |v: [f64; 2]| v[0] * dir[0] + v[1] * dir[1];
     // The last full cycle: segments j, j+1 that return to turning point j.
@@ -746,12 +752,12 @@ fn reduce_history(
         j = (k >= 2).then(|| Some(k - 2));
     }
     // The rows carry the volume worn so far.
-    let wear = !worn.is_empty();
-    let worn_volume = steps.last().map(|r| r.worn_volume_m3).filter(|_| wear);
-    let worn_per_cycle = cycle
-        .filter(|_| wear)
-        .map(|(s0, s1)| steps[s1].worn_volume_m3 - steps[s0].worn_volume_m3);
-    let worn_depth_max = wear.then(|| worn.iter().cloned().fold(0.0, f64::max));
+    // Per physical cycle: a simulated one stands for `jump`.
+    let worn_volume = wear.and(steps.last().map(|r| r.worn_volume_m3));
+    let worn_per_cycle = wear
+        .zip(cycle)
+        .map(|((_, jump), (s0, s1))| (steps[s1].worn_volume_m3 - steps[s0].worn_volume_m3) / jump);
+    let worn_depth_max = wear.map(|(worn, _)| worn.iter().cloned().fold(0.0, f64::max));
     let regime = (!regimes.is_empty()).then(|| {
         if regimes.iter().all(|&g| g) {
             "gross".to_string()

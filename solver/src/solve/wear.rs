@@ -178,18 +178,8 @@ impl Wearing {
     /// [`Wearing::layer`] is made for the normal solve and
     /// [`Wearing::commit`] applies it.
     pub fn prepare(&mut self, p0: &[f64], p1: &[f64], slip_mid: Slip) {
-        let da = self.grid.cell_area();
         if !self.implicit() {
-            for &d in &self.dh {
-                self.volume += d * da;
-            }
-            deposit(&mut self.worn, self.grid, slip_mid, &self.dh);
-            if !self.ball.is_empty() {
-                self.ball_volume += self.dh_ball.iter().sum::<f64>() * da;
-                for (w, &d) in self.ball.iter_mut().zip(&self.dh_ball) {
-                    *w += d;
-                }
-            }
+            self.apply(slip_mid);
             return;
         }
         let jump = self.wear.jump;
@@ -220,17 +210,26 @@ impl Wearing {
         if !self.implicit() {
             return;
         }
-        let da = self.grid.cell_area();
         for (d, &pi) in self.dh.iter_mut().zip(p) {
             *d *= pi;
-            self.volume += *d * da;
+        }
+        for (d, &pi) in self.dh_ball.iter_mut().zip(p) {
+            *d *= pi;
+        }
+        self.apply(slip_mid);
+    }
+
+    /// Adds the increment's depths `dh` (the substrate's placed by
+    /// `slip_mid`) and `dh_ball` to the worn depths and volumes.
+    fn apply(&mut self, slip_mid: Slip) {
+        let da = self.grid.cell_area();
+        for &d in &self.dh {
+            self.volume += d * da;
         }
         deposit(&mut self.worn, self.grid, slip_mid, &self.dh);
-        if !self.ball.is_empty() {
-            for ((w, d), &pi) in self.ball.iter_mut().zip(&self.dh_ball).zip(p) {
-                *w += d * pi;
-                self.ball_volume += d * pi * da;
-            }
+        for (w, &d) in self.ball.iter_mut().zip(&self.dh_ball) {
+            *w += d;
+            self.ball_volume += d * da;
         }
     }
 
