@@ -16,6 +16,7 @@ use crate::operators::operator::{X, Y, Z};
 use crate::solve::coupling::{solve_step, ContactState, Previous, Step, Target};
 use crate::solve::normal::{NormalProblem, NormalSolution};
 use crate::solve::resident::Resident;
+use crate::solve::tangential::TangentialSolution;
 use crate::solve::wear::{CycleRows, Wearing};
 pub use crate::solve::wear::{WearCycle, SCAR_DEFINITION, WEAR_JUMP_LIMIT};
 
@@ -166,6 +167,20 @@ pub(crate) struct HistoryState {
     pub worn_saved: Vec<(usize, Vec<f64>)>,
 }
 
+/// With coupling, the normal surface displacement `uz(q)` of the tractions
+/// of `tangential` (a normal solve's extra gap); empty without.
+fn traction_gap(res: &mut Resident, coupling: bool, tangential: &TangentialSolution) -> Vec<f64> {
+    let mut hq = Vec::new();
+    if coupling {
+        hq = vec![0.0; tangential.qx.len()];
+        res.operator.apply(
+            &[(X, &tangential.qx), (Y, &tangential.qy)],
+            &mut [(Z, &mut hq)],
+        );
+    }
+    hq
+}
+
 /// Total tangential surface displacement `ut(q) + [ut(p) − ut(p⁰)]` (the
 /// bracket only with coupling).
 fn displacement(
@@ -229,12 +244,13 @@ pub(crate) fn solve_history(
         .then(|| (0..len).map(|i| h0[i] + at(&dent, i)).collect());
     // With a wear law: the normal contact on the surface the last
     // increment wore, which the next starts from.
-    let mut worn_normal: Option<NormalSolution> = None;
+    // (And its tractions' normal displacement.)
+    let mut worn_normal: Option<(NormalSolution, Vec<f64>)> = None;
     let mut last = ContactState {
         p: normal0.p,
         approach: normal0.approach,
         plastic: normal0.plastic,
-        tangential: crate::solve::tangential::TangentialSolution {
+        tangential: TangentialSolution {
             qx: vec![0.0; len],
             qy: vec![0.0; len],
             sx: vec![0.0; len],
@@ -304,7 +320,7 @@ pub(crate) fn solve_history(
             let on_worn = worn_normal.take();
             let normal = if p_k == p_prev {
                 let (p, approach) = match on_worn {
-                    Some(n) => (n.p, n.approach),
+                    Some((n, _)) => (n.p, n.approach),
                     None => (last.p.clone(), last.approach),
                 };
                 NormalSolution {
@@ -319,14 +335,11 @@ pub(crate) fn solve_history(
                     },
                 }
             } else {
-                let mut hq = Vec::new();
-                if num.coupling {
-                    hq = vec![0.0; len];
-                    res.operator.apply(
-                        &[(X, &last.tangential.qx), (Y, &last.tangential.qy)],
-                        &mut [(Z, &mut hq)],
-                    );
-                }
+                // (The wear's normal solve made it for the same tractions.)
+                let hq = match on_worn {
+                    Some((_, hq)) => hq,
+                    None => traction_gap(res, num.coupling, &last.tangential),
+                };
                 res.solve_normal(&NormalProblem {
                     extra_gap: num.coupling.then_some(&hq[..]),
                     tolerance: num.tolerance,
@@ -471,14 +484,7 @@ pub(crate) fn solve_history(
                 moved = false;
             }
             if let (Some(w), Some(((mx, my), _))) = (&mut wearing, &slips) {
-                let mut hq = Vec::new();
-                if num.coupling {
-                    hq = vec![0.0; len];
-                    res.operator.apply(
-                        &[(X, &state.tangential.qx), (Y, &state.tangential.qy)],
-                        &mut [(Z, &mut hq)],
-                    );
-                }
+                let hq = traction_gap(res, num.coupling, &state.tangential);
                 let solved = res.solve_normal(&NormalProblem {
                     extra_gap: num.coupling.then_some(&hq[..]),
                     tolerance: num.tolerance,
@@ -498,7 +504,7 @@ pub(crate) fn solve_history(
                 }
                 normal_iterations += solved.report.iterations;
                 step_converged &= solved.report.converged;
-                worn_normal = Some(solved);
+                worn_normal = Some((solved, hq));
             }
             if moved {
                 rewrite(&mut dented, &dent, &wearing);
