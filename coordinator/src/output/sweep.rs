@@ -566,6 +566,39 @@ struct Panel {
     series: BTreeMap<String, Vec<(f64, f64, Option<f64>)>>,
 }
 
+/// One panel per material, titled "material: `what`", of `value` (y and
+/// its error bar) against the angle, a curve per surface of the points
+/// that have one; none for a material without any.
+fn panels_of(
+    points: &[CurvePoint],
+    what: &str,
+    y_desc: &'static str,
+    value: impl Fn(&CurvePoint) -> Option<(f64, Option<f64>)>,
+) -> Vec<Panel> {
+    let mut panels: BTreeMap<&str, Panel> = BTreeMap::new();
+    for ((material, surface), pts) in by_curve(points) {
+        let series: Vec<(f64, f64, Option<f64>)> = pts
+            .iter()
+            .filter_map(|p| {
+                let (y, err) = value(p)?;
+                Some((p.key.angle_deg, y, err))
+            })
+            .collect();
+        if !series.is_empty() {
+            panels
+                .entry(material)
+                .or_insert_with(|| Panel {
+                    title: format!("{material}: {what}"),
+                    y_desc,
+                    series: BTreeMap::new(),
+                })
+                .series
+                .insert(surface, series);
+        }
+    }
+    panels.into_values().collect()
+}
+
 /// Draw μa versus angle to `path` (PNG or SVG by extension): one panel per
 /// material, one series per surface with markers at the computed angles
 /// and error bars where a ladder gave them, the flat surface in black; and,
@@ -601,73 +634,38 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
             k_e.series.insert(name, ke.collect());
         }
     }
-    // Energy per cycle (load histories): one panel per material, in μJ.
-    let mut energy: BTreeMap<&str, Panel> = BTreeMap::new();
-    for ((material, surface), pts) in by_curve(points) {
-        let uj = |v: f64| v * 1e6;
-        let e: Vec<(f64, f64, Option<f64>)> = pts
-            .iter()
-            .filter_map(|p| {
-                let d = p.dissipated.as_ref()?;
-                Some((p.key.angle_deg, uj(d.value), d.err.map(uj)))
-            })
-            .collect();
-        if !e.is_empty() {
-            energy
-                .entry(material)
-                .or_insert_with(|| Panel {
-                    title: format!("{material}: energy per cycle"),
-                    y_desc: "dissipated per cycle (μJ)",
-                    series: BTreeMap::new(),
-                })
-                .series
-                .insert(surface, e);
-        }
-    }
-    // With a wear law: the worn volume over the path, per material, in µm³.
-    let mut worn: BTreeMap<&str, Panel> = BTreeMap::new();
-    for ((material, surface), pts) in by_curve(points) {
-        let v: Vec<(f64, f64, Option<f64>)> = pts
-            .iter()
-            .filter_map(|p| Some((p.key.angle_deg, p.wear?.0 * 1e18, None)))
-            .collect();
-        if !v.is_empty() {
-            worn.entry(material)
-                .or_insert_with(|| Panel {
-                    title: format!("{material}: worn volume"),
-                    y_desc: "worn volume over the path (μm³)",
-                    series: BTreeMap::new(),
-                })
-                .series
-                .insert(surface, v);
-        }
-    }
-    // With [stress]: the largest von Mises stress over p_H, per material.
-    let mut stress: BTreeMap<&str, Panel> = BTreeMap::new();
-    for ((material, surface), pts) in by_curve(points) {
-        let vm: Vec<(f64, f64, Option<f64>)> = pts
-            .iter()
-            .filter_map(|p| {
-                let l = p.stress.as_ref()?.worst(|st| Some(st.max_von_mises))?;
-                Some((p.key.angle_deg, l.over_p_h, None))
-            })
-            .collect();
-        if !vm.is_empty() {
-            stress
-                .entry(material)
-                .or_insert_with(|| Panel {
-                    title: format!("{material}: largest von Mises stress"),
-                    y_desc: "max von Mises / p_H (–)",
-                    series: BTreeMap::new(),
-                })
-                .series
-                .insert(surface, vm);
-        }
-    }
+    // Energy per cycle (load histories), in μJ; with a wear law, the worn
+    // volume over the path, in µm³; with [stress], the largest von Mises
+    // stress over p_H: one panel per material each.
+    let uj = |v: f64| v * 1e6;
+    let energy = panels_of(
+        points,
+        "energy per cycle",
+        "dissipated per cycle (μJ)",
+        |p| {
+            let d = p.dissipated.as_ref()?;
+            Some((uj(d.value), d.err.map(uj)))
+        },
+    );
+    let worn = panels_of(
+        points,
+        "worn volume",
+        "worn volume over the path (μm³)",
+        |p| Some((p.wear?.0 * 1e18, None)),
+    );
+    let stress = panels_of(
+        points,
+        "largest von Mises stress",
+        "max von Mises / p_H (–)",
+        |p| {
+            let l = p.stress.as_ref()?.worst(|st| Some(st.max_von_mises))?;
+            Some((l.over_p_h, None))
+        },
+    );
     let mut panels: Vec<Panel> = by_material.into_values().collect();
-    panels.extend(energy.into_values());
-    panels.extend(worn.into_values());
-    panels.extend(stress.into_values());
+    panels.extend(energy);
+    panels.extend(worn);
+    panels.extend(stress);
     if !k_e.series.is_empty() {
         panels.push(k_e);
     }
