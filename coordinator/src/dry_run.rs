@@ -8,7 +8,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::config::Config;
-use crate::cost::{case_seconds, kernel_seconds, stress_kernels, stress_seconds, CASE_EXPONENT};
+use crate::cost::{
+    case_seconds, kernel_seconds, stress_kernels, stress_sweep_seconds, CASE_EXPONENT,
+};
 use solver::KernelKey;
 
 fn human_seconds(s: f64) -> String {
@@ -49,7 +51,8 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     }
     let stress_bytes = config.stress.as_ref().map_or(0.0, |cfg| {
         let states = crate::memory::stress_states(cfg, cases.iter().map(|(_, s)| s));
-        crate::memory::stress_bytes(n, cfg, states)
+        let materials = crate::memory::stress_materials(cases.iter().map(|(_, s)| s));
+        crate::memory::stress_bytes(n, cfg, states, materials)
     });
     let per_worker = crate::memory::worker_bytes(n, kernels.len()) + stress_bytes;
     crate::memory::check_fits(
@@ -173,13 +176,10 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     );
     let stress: f64 = match &config.stress {
         Some(cfg) => {
-            let t: f64 = cases
-                .iter()
-                .map(|(_, spec)| stress_seconds(spec, cfg))
-                .sum();
+            let t = stress_sweep_seconds(cases.iter().map(|(_, spec)| spec), cfg, workers_used);
             let _ = writeln!(
                 s,
-                "stress:    {} depth kernels a case (planes and the surface for SWT; slice rows deeper than 5 cells need none), about {:.1} s a case more (measured at 256², scaled as N²; the surface counted in every case)",
+                "stress:    {} depth kernels per material (planes and the surface for SWT; slice rows need none), built once by each worker and kept; about {:.1} s a case more on average (measured at 256², scaled as N²)",
                 stress_kernels(cfg),
                 t / cases.len() as f64
             );

@@ -26,22 +26,47 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
 }
 
 /// Estimated extra peak bytes of `[stress]` in a worker on an `n x n` grid
-/// (counted from the arrays, B per cell): the surface's depth kernel, which
-/// a worker keeps between cases (`solver::stress_summary::StressCache`),
-/// and one more at a time for the other planes and the slice rows (18
-/// spectra of the padded grid, 576 each), the transforms' scratch (256),
+/// for a sweep of `materials` materials (counted from the arrays, B per
+/// cell): the depth kernels a worker keeps between cases
+/// (`solver::stress_summary::StressCache`: the surface's and the
+/// requested planes' of each material, 576 each, within
+/// `KEPT_PLANE_BYTES`, the current material's surface beyond it) and one
+/// more in flight when they do not all fit, the transforms' scratch (256),
 /// per state the traction spectra (96) and its planes (48 each, the
 /// surface's for SWT included), and the Crossland and SWT maps (8 each).
-/// 256², Fe, one state, one plane and 25 slice rows: 152 MB with the
-/// solve's 46 (before issue #51 one kernel lived at a time: 115 MB
-/// estimated, 107 MB measured peak of `mpcontact solve --threads 1`).
-pub fn stress_bytes(n: usize, cfg: &crate::config::StressCfg, states: usize) -> f64 {
+/// 256², Fe and Fe(111), one state, two planes and 41 slice rows (Table
+/// 1(a) with `[stress]`): 281 MB with the solve's 46, 350 MB peak measured
+/// of `mpcontact run --workers 1` (issue #51, docs/performance.md).
+pub fn stress_bytes(
+    n: usize,
+    cfg: &crate::config::StressCfg,
+    states: usize,
+    materials: usize,
+) -> f64 {
     let cells = (n * n) as f64;
     let planes = (cfg.depths_um.len() + 1) as f64;
-    let deeper = cfg.slices || cfg.depths_um.iter().any(|&z| z != 0.0);
-    let kernels = if deeper { 2.0 } else { 1.0 };
+    let kernel = 576.0 * cells;
+    let wanted = planes * materials.max(1) as f64 * kernel;
+    let budget = solver::stress_summary::KEPT_PLANE_BYTES.max(kernel);
+    let kernels = if wanted <= budget {
+        wanted
+    } else {
+        budget + kernel
+    };
     let states = states.max(1) as f64;
-    cells * (576.0 * kernels + 256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
+    kernels + cells * (256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
+}
+
+/// The materials (with their ball) a sweep's stresses are computed on: a
+/// worker keeps depth kernels for each (`stress_bytes`).
+pub fn stress_materials<'a>(specs: impl Iterator<Item = &'a solver::CaseSpec>) -> usize {
+    let mut seen: Vec<&solver::Material> = Vec::new();
+    for s in specs {
+        if !seen.contains(&&s.material) {
+            seen.push(&s.material);
+        }
+    }
+    seen.len()
 }
 
 /// The most states a case of `cases` has its stresses computed at (the

@@ -2,9 +2,8 @@
 //! #38 and #51): the plan of a material, the kernel of one depth plane, the
 //! three traction transforms of a state, a full plane and one line (a row
 //! of an x–z slice), and an x–z slice of 41 rows as `stress_summary` makes
-//! it (the surface row from the surface plane, the rows within the
-//! aliases' reach from their planes, the deeper ones together without
-//! planes), with the surface plane built and kept (a sweep's later cases),
+//! it (the surface row from the surface plane, the others together
+//! without planes), with the surface plane built and kept (a sweep's later cases),
 //! for an isotropic and a (111) substrate.
 //!
 //! `cargo run --release -p mpcontact-solver --example stress_cost -- [N ...]`
@@ -81,16 +80,9 @@ fn main() {
                     }
                 };
                 let _ = plan.apply_line(top, &states[0], Line::Row(n / 2));
-                let mut deep = Vec::new();
-                for &z in &depths[1..] {
-                    if plan.sums_aliases(z) {
-                        let pl = plan.plane(z).unwrap();
-                        let _ = plan.apply_line(&pl, &states[0], Line::Row(n / 2));
-                    } else {
-                        deep.push(z);
-                    }
-                }
-                let _ = plan.slice(&deep, &states, &[Line::Row(n / 2)]).unwrap();
+                let _ = plan
+                    .slice(&depths[1..], &states, &[Line::Row(n / 2)])
+                    .unwrap();
                 t0.elapsed().as_secs_f64()
             };
             let t_slice = slice(None);

@@ -229,6 +229,21 @@ pub fn swt_point(states: &[[f64; 6]], compliance: &Matrix6<f64>) -> SwtPoint {
     swt_of_strains(states, &strains)
 }
 
+/// `(cos² t, sin² t, sin t cos t)` of the SWT planes' normals, made once
+/// (a sine and cosine per direction and cell were a tenth of a sweep's
+/// time with `[stress]`).
+fn swt_directions() -> &'static [(f64, f64, f64); SWT_DIRECTIONS] {
+    static TABLE: std::sync::OnceLock<[(f64, f64, f64); SWT_DIRECTIONS]> =
+        std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|k| {
+            let deg = k as f64 * 180.0 / SWT_DIRECTIONS as f64;
+            let (s, c) = deg.to_radians().sin_cos();
+            (c * c, s * s, s * c)
+        })
+    })
+}
+
 fn swt_of_strains(states: &[[f64; 6]], strains: &[[f64; 6]]) -> SwtPoint {
     let mut best = SwtPoint {
         value: 0.0,
@@ -237,10 +252,8 @@ fn swt_of_strains(states: &[[f64; 6]], strains: &[[f64; 6]]) -> SwtPoint {
         strain_amplitude: 0.0,
     };
     let single = states.len() == 1;
-    for k in 0..SWT_DIRECTIONS {
+    for (k, &(cc, ss, sc)) in swt_directions().iter().enumerate() {
         let deg = k as f64 * 180.0 / SWT_DIRECTIONS as f64;
-        let (s, c) = deg.to_radians().sin_cos();
-        let (cc, ss, sc) = (c * c, s * s, s * c);
         let (mut smax, mut emax, mut emin) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::INFINITY);
         for (t, e) in states.iter().zip(strains) {
             smax = smax.max(t[0] * cc + t[1] * ss + 2.0 * t[5] * sc);
@@ -296,21 +309,39 @@ fn crossland_at(ts: &[[f64; 6]], alpha: f64) -> f64 {
     amp + alpha * sh
 }
 
+/// Bytes of depth kernels a worker keeps between cases, over all its
+/// materials: 512 MiB, 13 planes at 256², 3 at 512² (576 B a cell, see
+/// [`StressPlane::bytes`]); the current material's first plane (its
+/// surface, which every case asks for) is kept beyond it.
+pub const KEPT_PLANE_BYTES: f64 = 512.0 * 1024.0 * 1024.0;
+
+/// Materials (with their grid) whose plans a worker keeps.
+pub const KEPT_PLANS: usize = 4;
+
 /// What the cases of a sweep share for their stresses, kept by a worker
-/// from one case to the next: the plan of the last material and grid and
-/// its surface plane (for SWT and the slices' top row), which every case
-/// asks for again and which costs most (its kernel sums 81 alias orders
-/// per frequency: 0.9 s at 256² against 0.05 s for a plane 5 cells deep
-/// or more, docs/performance.md). Deeper planes cost about as much as
-/// applying them and are built per case, which keeps a worker's memory to
-/// two kernels. A case of another material or grid replaces the plan. The
-/// plane is the one a case would build itself, to the bit: `solve` and a
-/// sweep agree.
+/// from one case to the next: per material and grid (the last
+/// [`KEPT_PLANS`] used) the plan, with its periodic images' spectra by
+/// depth, and the depth planes its cases asked for, within
+/// [`KEPT_PLANE_BYTES`] (a plane needed again by the current material
+/// evicts the planes of the least recently used others first). All of it
+/// depends on the material, the grid and the depth only: a plane is the one
+/// a case would build itself, to the bit, so `solve` and a sweep agree.
 #[derive(Default)]
 pub struct StressCache {
-    key: Option<(Material, Grid)>,
-    plan: Option<StressPlan>,
+    /// Least recently used first.
+    entries: Vec<Kept>,
+}
+
+struct Kept {
+    key: (Material, Grid),
+    plan: StressPlan,
     planes: Vec<StressPlane>,
+}
+
+/// A plane for a case: one the cache keeps, or the case's own.
+enum PlaneRef {
+    Kept(usize),
+    Own(Box<StressPlane>),
 }
 
 impl StressCache {
@@ -319,56 +350,77 @@ impl StressCache {
         Self::default()
     }
 
-    /// The plan of `material` on `grid` and the kept planes, made anew
-    /// when either differs from the last case's.
-    fn prepare(
-        &mut self,
-        material: &Material,
-        grid: Grid,
-    ) -> Result<(&mut StressPlan, &mut Vec<StressPlane>), SolverError> {
-        let same = matches!(&self.key, Some((m, g)) if m == material && *g == grid);
-        if !same || self.plan.is_none() {
-            self.planes.clear();
-            self.plan = None;
-            self.key = None;
-            self.plan = Some(StressPlan::new(material, grid)?);
-            self.key = Some((material.clone(), grid));
+    /// Makes the entry of `material` on `grid` the current (last) one,
+    /// its plan made when missing (the least recently used entry leaves
+    /// beyond [`KEPT_PLANS`]).
+    fn prepare(&mut self, material: &Material, grid: Grid) -> Result<(), SolverError> {
+        match self
+            .entries
+            .iter()
+            .position(|k| &k.key.0 == material && k.key.1 == grid)
+        {
+            Some(i) => {
+                let kept = self.entries.remove(i);
+                self.entries.push(kept);
+            }
+            None => {
+                let plan = StressPlan::new(material, grid)?;
+                if self.entries.len() == KEPT_PLANS {
+                    self.entries.remove(0);
+                }
+                self.entries.push(Kept {
+                    key: (material.clone(), grid),
+                    plan,
+                    planes: Vec::new(),
+                });
+            }
         }
-        let plan = self.plan.as_mut().expect("made above");
-        Ok((plan, &mut self.planes))
+        Ok(())
+    }
+
+    fn current(&mut self) -> &mut Kept {
+        self.entries.last_mut().expect("prepared")
+    }
+
+    /// The plane at `depth_m` of the current material: kept (built when
+    /// missing and kept when the budget allows), else the case's own.
+    fn plane(&mut self, depth_m: f64) -> Result<PlaneRef, SolverError> {
+        let here = self.entries.len() - 1;
+        if let Some(i) = self.entries[here]
+            .planes
+            .iter()
+            .position(|p| p.depth_m().to_bits() == depth_m.to_bits())
+        {
+            return Ok(PlaneRef::Kept(i));
+        }
+        let plane = self.entries[here].plan.plane(depth_m)?;
+        let bytes = plane.bytes();
+        let held = |entries: &[Kept]| -> f64 {
+            entries
+                .iter()
+                .flat_map(|k| k.planes.iter().map(StressPlane::bytes))
+                .sum()
+        };
+        let mut older = 0;
+        while held(&self.entries) + bytes > KEPT_PLANE_BYTES && older < here {
+            self.entries[older].planes.clear();
+            older += 1;
+        }
+        let first = self.entries[here].planes.is_empty();
+        if first || held(&self.entries) + bytes <= KEPT_PLANE_BYTES {
+            self.entries[here].planes.push(plane);
+            Ok(PlaneRef::Kept(self.entries[here].planes.len() - 1))
+        } else {
+            Ok(PlaneRef::Own(Box::new(plane)))
+        }
     }
 }
 
-/// The index of the kept plane at `depth_m` (the same bits: the surface),
-/// built and kept when missing.
-fn kept_plane(
-    plan: &mut StressPlan,
-    planes: &mut Vec<StressPlane>,
-    depth_m: f64,
-) -> Result<usize, SolverError> {
-    if let Some(i) = planes
-        .iter()
-        .position(|p| p.depth_m().to_bits() == depth_m.to_bits())
-    {
-        return Ok(i);
-    }
-    planes.push(plan.plane(depth_m)?);
-    Ok(planes.len() - 1)
-}
-
-/// The plane at depth `z`: at the surface the kept one ([`kept_plane`]),
-/// elsewhere `plan`'s own, built into `own`.
-fn plane_at<'a>(
-    plan: &mut StressPlan,
-    kept: &'a mut Vec<StressPlane>,
-    z: f64,
-    own: &'a mut Option<StressPlane>,
-) -> Result<&'a StressPlane, SolverError> {
-    if z == 0.0 {
-        let i = kept_plane(plan, kept, z)?;
-        Ok(&kept[i])
-    } else {
-        Ok(own.insert(plan.plane(z)?))
+/// The plane `r` refers to among the current material's `kept` planes.
+fn resolve<'a>(r: &'a PlaneRef, kept: &'a [StressPlane]) -> &'a StressPlane {
+    match r {
+        PlaneRef::Kept(i) => &kept[*i],
+        PlaneRef::Own(p) => p,
     }
 }
 
@@ -405,7 +457,18 @@ pub fn compute_with(
     } else {
         vec![(None, &fields.p[..], &fields.qx[..], &fields.qy[..])]
     };
-    let (plan, kept) = cache.prepare(&spec.material, grid)?;
+    cache.prepare(&spec.material, grid)?;
+    // The planes first (the surface's, which SWT and the slices' top row
+    // read, before the request's), then the plan and the kept planes.
+    let surface_plane = cache.plane(0.0)?;
+    let depths_m = req.depths_m.clone();
+    let depth_planes = depths_m
+        .iter()
+        .map(|&z| cache.plane(z))
+        .collect::<Result<Vec<_>, _>>()?;
+    let Kept {
+        plan, planes: kept, ..
+    } = cache.current();
     let tractions: Vec<_> = states
         .iter()
         .map(|(_, p, qx, qy)| plan.tractions(p, qx, qy))
@@ -442,12 +505,10 @@ pub fn compute_with(
         })
         .collect();
     // One kernel per depth, applied to every state.
-    // The slices: the rows deeper than the aliases reach all at once
-    // (`StressPlan::slice`, no plane built), the others from their planes.
-    let direct: Vec<bool> = slice_depths
-        .iter()
-        .map(|&z| z != 0.0 && !plan.sums_aliases(z))
-        .collect();
+    // The slices: the rows below the surface all at once
+    // (`StressPlan::slice`, no plane built), the surface's from its plane
+    // (kept for SWT).
+    let direct: Vec<bool> = slice_depths.iter().map(|&z| z != 0.0).collect();
     let deep: Vec<f64> = slice_depths
         .iter()
         .zip(&direct)
@@ -459,7 +520,7 @@ pub fn compute_with(
         plan.slice(&deep, &tractions, &[along, across])?
     };
     let mut next_deep = 0;
-    for (&z, &direct) in slice_depths.iter().zip(&direct) {
+    for &direct in &direct {
         if direct {
             for (s, rows) in out.iter_mut().zip(&deep_rows) {
                 s.along.push(rows[0][next_deep].clone());
@@ -469,18 +530,15 @@ pub fn compute_with(
             continue;
         }
         // The slices' top row is the surface plane's, kept for SWT.
-        let mut own = None;
-        let plane = plane_at(plan, kept, z, &mut own)?;
+        let plane = resolve(&surface_plane, kept);
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.along.push(plan.apply_line(plane, t, along));
             s.across.push(plan.apply_line(plane, t, across));
         }
     }
-    let depths_m = req.depths_m.clone();
     let mut surface: Option<Vec<StressField>> = None;
-    for &z in &depths_m {
-        let mut own = None;
-        let plane = plane_at(plan, kept, z, &mut own)?;
+    for r in &depth_planes {
+        let plane = resolve(r, kept);
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.planes.push(plan.apply(plane, t));
         }
@@ -488,8 +546,8 @@ pub fn compute_with(
     // The surface plane for SWT: a plane of the request at z = 0, else its own.
     let on_surface = depths_m.iter().position(|&z| z == 0.0);
     if on_surface.is_none() {
-        let i = kept_plane(plan, kept, 0.0)?;
-        surface = Some(tractions.iter().map(|t| plan.apply(&kept[i], t)).collect());
+        let plane = resolve(&surface_plane, kept);
+        surface = Some(tractions.iter().map(|t| plan.apply(plane, t)).collect());
     }
     let surface_of = |k: usize| -> &StressField {
         match (&surface, on_surface) {
