@@ -288,8 +288,10 @@ fn each_depth_plane_carries_the_applied_forces() {
 /// cell would not do).
 #[test]
 fn surface_stresses_under_sliding_equal_hookes_law_on_the_surface_strains() {
+    // (6.9e-5 and 6.7e-5 p0 with the surface's alias series converged,
+    // issue #51; 8.2e-4 and 5.9e-4 with 4 orders before)
     let errors: Vec<f64> = [64, 128].map(hooke).to_vec();
-    assert!(errors[1] < 1e-3, "{errors:?}");
+    assert!(errors.iter().all(|&e| e < 2e-4), "{errors:?}");
 }
 
 fn hooke(n: usize) -> f64 {
