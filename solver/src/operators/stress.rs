@@ -1084,16 +1084,16 @@ impl StressPlan {
         let h = m / 2 + 1;
         let aliases = self.aliases(depth_m, cap);
         let split = aliases > 0;
-        let mut kernel = vec![[C::default(); 18]; h * m];
-        {
+        // (collected, not zeroed first and overwritten: the 38 MB of a
+        // 256² kernel were written twice)
+        let mut kernel: Vec<[C; 18]> = {
             use rayon::prelude::*;
             let this = &*self;
-            kernel.par_chunks_mut(m).enumerate().for_each(|(kx, col)| {
-                for (ky, v) in col.iter_mut().enumerate() {
-                    *v = this.kernel_at(kx, ky, depth_m, split);
-                }
-            });
-        }
+            (0..h * m)
+                .into_par_iter()
+                .map(|i| this.kernel_at(i / m, i % m, depth_m, split))
+                .collect()
+        };
         if split {
             let near = self.near_field(depth_m, aliases);
             self.add_near(&near, &mut kernel);
