@@ -203,6 +203,8 @@ fn phi1(u: C) -> C {
 #[derive(Clone, Copy, Debug)]
 struct Node {
     lam: [C; 3],
+    /// The slowest decay of its roots, `min −Im λ`.
+    decay: f64,
     /// Largest distance between two roots.
     spread: f64,
     /// The pairs `(0, 1), (0, 2), (1, 2)`: `|λⱼ − λᵢ|` and `1/(λⱼ − λᵢ)`
@@ -289,6 +291,7 @@ impl Node {
         };
         Node {
             lam,
+            decay: lam.iter().map(|l| -l.im).fold(f64::INFINITY, f64::min),
             spread: gap[far],
             gap,
             inv,
@@ -565,6 +568,11 @@ impl Response {
             }
         } else {
             let nodes = self.nodes(theta);
+            // (this direction's own decay: a crystal's slowest root over
+            // all directions decays slower than most)
+            if self.decayed_at(&nodes, s) {
+                return acc;
+            }
             match self.interpolated(&nodes) {
                 // One node's exponentials where the roots interpolate.
                 Some(node) => {
@@ -593,6 +601,15 @@ impl Response {
     /// frequencies are left out (at 25 cells deep, 80 % of them).
     fn decayed(&self, s: f64) -> bool {
         self.slowest * s > DECAY_LIMIT
+    }
+
+    /// [`Response::decayed`] with the roots of a direction's four `nodes`.
+    fn decayed_at(&self, nodes: &[(usize, f64); 4], s: f64) -> bool {
+        let decay = nodes
+            .iter()
+            .map(|&(i, _)| self.nodes[i].decay)
+            .fold(f64::INFINITY, f64::min);
+        decay * s > DECAY_LIMIT
     }
 
     /// The response at `η = 0`: its limit depends on the direction; the
@@ -926,6 +943,10 @@ impl StressPlan {
         // The DFT `Σ f e^{−2πi k x/M}` is the transform at η = −2πk/(MΔ).
         let ex = -tau * signed(kx) / (m as f64 * dx);
         let ey = -tau * signed(ky) / (m as f64 * dy);
+        // (before the sines: most of a deep plane's frequencies)
+        if z > 0.0 && self.response.decayed((ex * ex + ey * ey).sqrt() * z) {
+            return [C::default(); 18];
+        }
         let mut b = sinc(0.5 * ex * dx) * sinc(0.5 * ey * dy);
         if split {
             b *= self.split(ex, ey);
@@ -1593,6 +1614,15 @@ impl StressPlan {
                     let w = if any_split { this.split(ex, ey) } else { 1.0 };
                     let rho = (ex * ex + ey * ey).sqrt();
                     let nodes = this.response.nodes(ey.atan2(ex));
+                    // The depth from which this direction has decayed.
+                    let decay = if iso {
+                        1.0
+                    } else {
+                        nodes
+                            .iter()
+                            .map(|&(i, _)| this.response.nodes[i].decay)
+                            .fold(f64::INFINITY, f64::min)
+                    };
                     // A crystal's smooth stencil: one interpolated node.
                     let interp = if iso {
                         None
@@ -1652,7 +1682,7 @@ impl StressPlan {
                                 }
                             }
                         }
-                        if this.response.decayed(s) {
+                        if decay * s > DECAY_LIMIT {
                             continue;
                         }
                         let mut gs = [[C::default(); 3]; 4];
