@@ -570,7 +570,7 @@ impl Response {
             let nodes = self.nodes(theta);
             // (this direction's own decay: a crystal's slowest root over
             // all directions decays slower than most)
-            if self.decayed_at(&nodes, s) {
+            if self.decay(&nodes) * s > DECAY_LIMIT {
                 return acc;
             }
             match self.interpolated(&nodes) {
@@ -603,13 +603,14 @@ impl Response {
         self.slowest * s > DECAY_LIMIT
     }
 
-    /// [`Response::decayed`] with the roots of a direction's four `nodes`.
-    fn decayed_at(&self, nodes: &[(usize, f64); 4], s: f64) -> bool {
-        let decay = nodes
+    /// The slowest decay of the roots of a direction's four `nodes`: its
+    /// response has decayed (as in [`Response::decayed`]) from
+    /// `s = DECAY_LIMIT / decay` on.
+    fn decay(&self, nodes: &[(usize, f64); 4]) -> f64 {
+        nodes
             .iter()
             .map(|&(i, _)| self.nodes[i].decay)
-            .fold(f64::INFINITY, f64::min);
-        decay * s > DECAY_LIMIT
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The response at `η = 0`: its limit depends on the direction; the
@@ -922,10 +923,15 @@ impl StressPlan {
     /// (where `F` is not smooth), so `(1 − w)F` is smooth and its stencil
     /// short (powers 8 and 4 left longer stencils at 0.3 to 4 cells deep).
     fn split(&self, ex: f64, ey: f64) -> f64 {
+        (-self.split_exponent(ex, ey)).exp()
+    }
+
+    /// `(|u|/SPLIT_RADIUS)^(2 SPLIT_POWER)`: `w = e^{−x}` and, without
+    /// cancellation near `η = 0`, `1 − w = −expm1(−x)`.
+    fn split_exponent(&self, ex: f64, ey: f64) -> f64 {
         let ux = ex * self.grid.dx / std::f64::consts::PI;
         let uy = ey * self.grid.dy / std::f64::consts::PI;
-        let r = (ux * ux + uy * uy) / (SPLIT_RADIUS * SPLIT_RADIUS);
-        (-r.powi(SPLIT_POWER)).exp()
+        ((ux * ux + uy * uy) / (SPLIT_RADIUS * SPLIT_RADIUS)).powi(SPLIT_POWER)
     }
 
     /// The discrete kernel spectrum (18 values) at padded-grid frequency
@@ -991,12 +997,9 @@ impl StressPlan {
                 for jy in -aliases..=aliases {
                     let ey = ey0 + tau * jy as f64 / dy;
                     let by = sinc(0.5 * ey * dy) * end(jy);
-                    let uy = ey * dy / std::f64::consts::PI;
                     for &(ex, bx) in &along_x {
-                        // 1 − w, without cancellation near η = 0
-                        let ux = ex * dx / std::f64::consts::PI;
-                        let r = (ux * ux + uy * uy) / (SPLIT_RADIUS * SPLIT_RADIUS);
-                        let b = bx * by * -(-r.powi(SPLIT_POWER)).exp_m1();
+                        // 1 − w
+                        let b = bx * by * -(-self.split_exponent(ex, ey)).exp_m1();
                         if b == 0.0 {
                             continue;
                         }
@@ -1615,14 +1618,7 @@ impl StressPlan {
                     let rho = (ex * ex + ey * ey).sqrt();
                     let nodes = this.response.nodes(ey.atan2(ex));
                     // The depth from which this direction has decayed.
-                    let decay = if iso {
-                        1.0
-                    } else {
-                        nodes
-                            .iter()
-                            .map(|&(i, _)| this.response.nodes[i].decay)
-                            .fold(f64::INFINITY, f64::min)
-                    };
+                    let decay = this.response.decay(&nodes);
                     // A crystal's smooth stencil: one interpolated node.
                     let interp = if iso {
                         None
