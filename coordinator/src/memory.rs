@@ -35,8 +35,9 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
 /// per state the traction spectra (96) and its planes (48 each, the
 /// surface's for SWT included), and the Crossland and SWT maps (8 each).
 /// 256², Fe and Fe(111), one state, two planes and 41 slice rows (Table
-/// 1(a) with `[stress]`): 281 MB with the solve's 46, 350 MB peak measured
-/// of `mpcontact run --workers 1` (issue #51, docs/performance.md).
+/// 1(a) with `[stress]`): 307 MB with the solve's kernels, 355 MB peak RSS
+/// measured of a worker of `mpcontact run --workers 2` (issue #51,
+/// docs/performance.md; the allocator's slack is not counted).
 pub fn stress_bytes(
     n: usize,
     cfg: &crate::config::StressCfg,
