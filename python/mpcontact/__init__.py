@@ -78,7 +78,8 @@ class Result:
         ``normal_force_n``, ``fx_n``, ``fy_n``, ``delta_x_m``, ``delta_y_m``,
         ``delta_z_m``, ``contact_area_m2``, ``stick_area_m2``,
         ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``, and
-        ``worn_volume_m3`` with a wear law). The per-cycle energy, reversal stiffness and residual shift are in
+        ``worn_volume_m3`` with a wear law, ``plastic_area_m2`` and
+        ``plastic_penetration_max_m`` on a surface with a hardness). The per-cycle energy, reversal stiffness and residual shift are in
         ``scalars`` as in ``case.json``."""
         h = self.scalars.get("history")
         if h is None:
@@ -106,6 +107,13 @@ class Result:
         # With a wear law, as the CLI's history.csv: the volume worn so far.
         if h.get("worn_volume_m3") is not None:
             table["worn_volume_m3"] = col(lambda r: r["worn_volume_m3"])
+        # With a hardness, as the CLI's history.csv: the area at the cap and
+        # the dent's deepest cell so far.
+        if any(r.get("plastic_area_m2") is not None for r in h["steps"]):
+            table["plastic_area_m2"] = col(lambda r: r.get("plastic_area_m2") or 0.0)
+            table["plastic_penetration_max_m"] = col(
+                lambda r: r.get("plastic_penetration_max_m") or 0.0
+            )
         return table
 
     def wear(self):

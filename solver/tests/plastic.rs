@@ -498,3 +498,67 @@ fn a_shear_limit_caps_the_sliding_force_at_the_integral_of_min_mu_p_tau() {
     assert!((f / closed - 1.0).abs() < 1e-3, "F against the closed form");
     assert!(f < 0.9 * mu * LOAD_1A, "the limit must bind");
 }
+
+#[test]
+fn a_fretting_path_on_a_capped_sphere_reports_its_plastic_area_and_a_dent_that_never_shrinks() {
+    // Fretting with coupling (the tractions shift the pressure) and the
+    // normal load lowered and raised again, on a surface whose hardness
+    // caps the Hertz peak: every row at the peak load has cells at the cap,
+    // and the dent's deepest cell never decreases along the path (the
+    // plastic penetration is permanent); the last row's is the case's.
+    let (_, p0) = hertz();
+    let cap = 0.7 * p0;
+    let mut spec = common::table_1a_fe(128, 3.0, true, 0.0);
+    spec.material = spec
+        .material
+        .with_limits(Limits {
+            hardness: Some(cap),
+            shear_limit: None,
+        })
+        .unwrap();
+    spec.history = Some(LoadHistory {
+        tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
+        normal_forces_n: Some(vec![LOAD_1A, LOAD_1A, 0.5 * LOAD_1A, LOAD_1A]),
+        steps_per_segment: 3,
+        shifts_m: None,
+        wear: None,
+    });
+    let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
+    assert!(out.scalars.converged);
+    let history = out.scalars.history.expect("a path");
+    let mut peak_rows = 0;
+    let mut last_dent = 0.0;
+    for r in &history.steps {
+        let area = r
+            .plastic_area_m2
+            .expect("a hardness gives every row its plastic area");
+        let dent = r.plastic_penetration_max_m.expect("and its dent");
+        if (r.normal_force_n - LOAD_1A).abs() < 1e-6 * LOAD_1A {
+            assert!(
+                area > 0.0,
+                "no plastic area at the peak load, step {}",
+                r.step
+            );
+            peak_rows += 1;
+        }
+        assert!(
+            dent >= last_dent,
+            "the dent shrank at step {}: {dent} after {last_dent}",
+            r.step
+        );
+        last_dent = dent;
+    }
+    assert!(peak_rows >= 5, "{peak_rows} rows at the peak load");
+    assert!(last_dent > 0.0);
+    let plastic = out.scalars.plastic.expect("a plastic zone");
+    assert_eq!(last_dent, plastic.penetration_max_m);
+    // An elastic path's rows carry neither column.
+    let mut elastic = spec.clone();
+    elastic.material = elastic.material.with_limits(Limits::default()).unwrap();
+    let out = solve_case(&elastic, &mut KernelCache::new()).unwrap();
+    let history = out.scalars.history.expect("a path");
+    assert!(history
+        .steps
+        .iter()
+        .all(|r| r.plastic_area_m2.is_none() && r.plastic_penetration_max_m.is_none()));
+}

@@ -20,13 +20,23 @@ pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_
 /// has the header above, to the byte).
 pub const HISTORY_WEAR_COLUMN: &str = "worn_volume_m3";
 
+/// The columns `history.csv` gains on a surface with a hardness (after the
+/// wear column, if any): the area at the cap and the dent's deepest cell so
+/// far (a path without a hardness has the header above, to the byte).
+pub const HISTORY_PLASTIC_COLUMNS: &str = "plastic_area_m2,plastic_penetration_max_m";
+
 /// Text of `history.csv`.
 pub fn history_csv(h: &HistoryOutput) -> String {
     let wear = h.worn_volume_m3.is_some();
+    let plastic = h.steps.iter().any(|r| r.plastic_area_m2.is_some());
     let mut out = String::from(HISTORY_HEADER);
     if wear {
         out.push(',');
         out.push_str(HISTORY_WEAR_COLUMN);
+    }
+    if plastic {
+        out.push(',');
+        out.push_str(HISTORY_PLASTIC_COLUMNS);
     }
     out.push('\n');
     for r in &h.steps {
@@ -49,6 +59,14 @@ pub fn history_csv(h: &HistoryOutput) -> String {
         );
         if wear {
             let _ = write!(out, ",{}", fmt_f64(r.worn_volume_m3));
+        }
+        if plastic {
+            let _ = write!(
+                out,
+                ",{},{}",
+                fmt_f64(r.plastic_area_m2.unwrap_or(0.0)),
+                fmt_f64(r.plastic_penetration_max_m.unwrap_or(0.0))
+            );
         }
         out.push('\n');
     }
@@ -206,6 +224,23 @@ mod tests {
             "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j"
         ));
         assert!(lines[3].starts_with("2,0,2,0,3e-6,0,"), "{}", lines[3]);
+        assert_eq!(lines[0], HISTORY_HEADER);
+    }
+
+    #[test]
+    fn a_hardness_adds_the_plastic_columns_last() {
+        let mut h = history();
+        for (k, r) in h.steps.iter_mut().enumerate() {
+            r.plastic_area_m2 = Some(1e-9 * k as f64);
+            r.plastic_penetration_max_m = Some(2e-7);
+        }
+        let text = history_csv(&h);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[0],
+            format!("{HISTORY_HEADER},{HISTORY_PLASTIC_COLUMNS}")
+        );
+        assert!(lines[3].ends_with(",true,2e-9,2e-7"), "{}", lines[3]);
     }
 
     #[test]

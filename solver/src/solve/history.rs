@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::geometry::covered_area;
 use crate::error::SolverError;
+use crate::model::material::limit_per_cell;
 use crate::model::radii::{apparent_radius, friction_reserve};
 use crate::model::spec::{CaseSpec, LoadHistory};
 use crate::model::surface::Terrain;
@@ -50,6 +51,14 @@ pub struct HistoryStep {
     /// without a wear law).
     #[serde(default)]
     pub worn_volume_m3: f64,
+    /// With a hardness: the area of the cells whose pressure is at the cap
+    /// (their covered part on cut cells), m² (`None`: elastic).
+    #[serde(default)]
+    pub plastic_area_m2: Option<f64>,
+    /// With a hardness: the largest plastic penetration of the dent from
+    /// the start of the path to this increment (it is permanent), m.
+    #[serde(default)]
+    pub plastic_penetration_max_m: Option<f64>,
     /// The increment's solves converged.
     pub converged: bool,
 }
@@ -286,6 +295,13 @@ pub(crate) fn solve_history(
         },
     )];
     rows[0].stick_area_m2 = rows[0].contact_area_m2;
+    // With a hardness, the dent's deepest cell (the dent only grows).
+    let deepest = |dent: &[f64]| {
+        spec.limits()
+            .hardness
+            .map(|_| dent.iter().cloned().fold(0.0, f64::max))
+    };
+    rows[0].plastic_penetration_max_m = deepest(&dent);
     let mut force_error_max: f64 = 0.0;
     let mut turning_steps = vec![0];
     let mut turning = vec![TurningState::of(0, &last)];
@@ -529,6 +545,7 @@ pub(crate) fn solve_history(
                 force_error_max = force_error_max.max(ferr);
             }
             r.worn_volume_m3 = wearing.as_ref().map_or(0.0, |w| w.volume);
+            r.plastic_penetration_max_m = deepest(&dent);
             rows.push(r);
             last = state;
             (p_prev, f_prev) = (p_k, f_k);
@@ -673,6 +690,14 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
         stick_radius_m: stick_radius,
         dissipated_j: sums.dissipated,
         worn_volume_m3: 0.0,
+        plastic_area_m2: spec.limits().hardness.map(|hardness| {
+            // The cells at the cap, as the case's `plastic_area_m2`.
+            let cover = terrain.cover.as_deref();
+            let caps = limit_per_cell(hardness, cover, len);
+            let capped: Vec<bool> = (0..len).map(|i| p[i] > 0.0 && p[i] >= caps[i]).collect();
+            covered_area(&capped, cover, da)
+        }),
+        plastic_penetration_max_m: None,
         converged: sums.converged,
     }
 }
