@@ -772,18 +772,26 @@ fn capped_cg(
     if rescale(p, zone).is_none() {
         return Ok(report);
     }
-    let (mut valid, mut g_old, mut delta) = (false, 1.0, 0.0);
+    // `uf = K` (the free cells' pressure) and `uzn = K` (the zone's caps),
+    // each made again only when what it sees changed.
+    let (mut valid, mut valid_zone, mut g_old, mut delta) = (false, false, 1.0, 0.0);
     for it in 1..=max_iterations.min(CAPPED_CG_BUDGET) {
         crate::base::progress::tick_or_cancel()?;
         report.iterations = it;
+        if !valid_zone {
+            for i in 0..len {
+                pz[i] = if zone[i] { cap[i] } else { 0.0 };
+            }
+            op.apply_zz(&pz, &mut uzn);
+            report.applications += 1;
+            valid_zone = true;
+        }
         if !valid {
             for i in 0..len {
                 pf[i] = if zone[i] { 0.0 } else { p[i] };
-                pz[i] = if zone[i] { cap[i] } else { 0.0 };
             }
             op.apply_zz(&pf, &mut uf);
-            op.apply_zz(&pz, &mut uzn);
-            report.applications += 2;
+            report.applications += 1;
             valid = true;
         }
         let (mut nc, mut sg) = (0usize, 0.0);
@@ -812,7 +820,7 @@ fn capped_cg(
             }
         }
         if released {
-            valid = false;
+            (valid, valid_zone) = (false, false);
             delta = 0.0;
             continue;
         }
@@ -900,6 +908,7 @@ fn capped_cg(
         let Some((scale, overlap, clipped, joined)) = stepped else {
             break;
         };
+        valid_zone &= !joined;
         if clipped || overlap || joined {
             valid = false;
         } else {
