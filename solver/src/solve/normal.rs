@@ -746,8 +746,9 @@ fn capped_cg(
     let mut free = vec![false; len];
     let mut p_old = vec![0.0; len];
     let mut zone_old = vec![false; len];
-    // Rescales the free cells to carry what the zone does not; false when
-    // the zone alone carries the load.
+    // The factor that rescales the free cells to carry what the zone does
+    // not (the zone's cells set to their caps); `None` when the zone alone
+    // carries the load.
     let rescale = |p: &mut [f64], zone: &[bool]| -> Option<f64> {
         let (mut carried, mut rest) = (0.0, 0.0);
         for i in 0..len {
@@ -761,16 +762,15 @@ fn capped_cg(
         if carried >= target || rest <= 0.0 || !rest.is_finite() {
             return None;
         }
-        let s = (target - carried) / rest;
-        for i in 0..len {
-            if !zone[i] {
-                p[i] *= s;
-            }
-        }
-        Some(s)
+        Some((target - carried) / rest)
     };
-    if rescale(p, zone).is_none() {
-        return Ok(report);
+    match rescale(p, zone) {
+        Some(s) => p
+            .iter_mut()
+            .zip(zone.iter())
+            .filter(|(_, &z)| !z)
+            .for_each(|(v, _)| *v *= s),
+        None => return Ok(report),
     }
     // `uf = K` (the free cells' pressure) and `uzn = K` (the zone's caps),
     // each made again only when what it sees changed.
@@ -794,13 +794,18 @@ fn capped_cg(
             report.applications += 1;
             valid = true;
         }
-        let (mut nc, mut sg) = (0usize, 0.0);
+        // (One pass: the memory, not the arithmetic, is what costs.)
+        let (mut nc, mut sg, mut reach, mut top) = (0usize, 0.0, 0.0_f64, f64::NEG_INFINITY);
         for i in 0..len {
-            g[i] = uf[i] + uzn[i] + h[i];
+            let ui = uf[i] + uzn[i];
+            reach = reach.max(ui.abs());
+            g[i] = ui + h[i];
             free[i] = !zone[i] && p[i] > 0.0;
             if free[i] {
                 nc += 1;
                 sg += g[i];
+            } else if zone[i] {
+                top = top.max(g[i]);
             }
         }
         if nc == 0 {
@@ -808,18 +813,14 @@ fn capped_cg(
         }
         let gbar = sg / nc as f64;
         // Zone cells whose surface lifted off the indenter leave it.
-        let reach = uf
-            .iter()
-            .zip(&uzn)
-            .fold(0.0_f64, |m, (a, b)| m.max((a + b).abs()));
-        let mut released = false;
-        for i in 0..len {
-            if zone[i] && g[i] > gbar + ZONE_SLACK * reach {
-                zone[i] = false;
-                released = true;
-            }
-        }
+        let lift = gbar + ZONE_SLACK * reach;
+        let released = top > lift;
         if released {
+            for i in 0..len {
+                if zone[i] && g[i] > lift {
+                    zone[i] = false;
+                }
+            }
             (valid, valid_zone) = (false, false);
             delta = 0.0;
             continue;
@@ -848,18 +849,16 @@ fn capped_cg(
         g_old = gg;
         op.apply_zz(&t, &mut r);
         report.applications += 1;
-        let (mut sr, mut num) = (0.0, 0.0);
+        let (mut sr, mut num, mut srt, mut st) = (0.0, 0.0, 0.0, 0.0);
         for i in 0..len {
             if free[i] {
                 sr += r[i];
                 num += g[i] * t[i];
+                srt += r[i] * t[i];
+                st += t[i];
             }
         }
-        let rbar = sr / nc as f64;
-        let den: f64 = (0..len)
-            .filter(|&i| free[i])
-            .map(|i| (r[i] - rbar) * t[i])
-            .sum();
+        let den = srt - sr / nc as f64 * st;
         if den <= 0.0 || !den.is_finite() {
             break;
         }
@@ -909,15 +908,18 @@ fn capped_cg(
             break;
         };
         valid_zone &= !joined;
-        if clipped || overlap || joined {
-            valid = false;
-        } else {
-            for i in 0..len {
+        valid &= !(clipped || overlap || joined);
+        delta = if overlap || joined { 0.0 } else { 1.0 };
+        let mut change = 0.0;
+        for i in 0..len {
+            if !zone[i] {
+                p[i] *= scale;
+            }
+            if valid {
                 uf[i] = scale * (uf[i] - tau * r[i]);
             }
+            change += (p[i] - p_old[i]).abs();
         }
-        delta = if overlap || joined { 0.0 } else { 1.0 };
-        let change: f64 = (0..len).map(|i| (p[i] - p_old[i]).abs()).sum();
         report.change = change * da / load_n;
         if report.change < tolerance && !joined {
             report.converged = true;
