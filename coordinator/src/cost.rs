@@ -37,11 +37,11 @@ const INCREMENT_COST: f64 = 0.6;
 /// an increment uncoupled against a coupled monotonic solve's 0.44 s).
 const WEAR_INCREMENT_COST: f64 = 0.09;
 
-/// A case on a surface with a hardness costs about 2.5 elastic ones: the
-/// paper's Table 1(c) surfaces at 512² took 2.0–2.1× the elastic sweep's
-/// time with H = 0.9 GPa and 3.2–3.4× with 0.5 GPa (docs/performance.md,
-/// "A capped surface"); a contact that does not yield costs what it did.
-const CAPPED_COST: f64 = 2.5;
+/// A case on a surface with a hardness costs about 1.5 elastic ones: the
+/// paper's Table 1(c) surfaces at 512² took 1.37× the elastic sweep's time
+/// with H = 0.9 GPa and 1.56–1.77× with 0.5 GPa with the capped CG (2.0–3.4×
+/// before it; docs/performance.md, "A capped surface").
+const CAPPED_COST: f64 = 1.5;
 
 /// Expected seconds of one case on one worker.
 pub fn case_seconds(spec: &CaseSpec) -> f64 {

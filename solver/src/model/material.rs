@@ -213,6 +213,20 @@ pub fn limit_per_cell(limit: f64, cover: Option<&[f64]>, len: usize) -> Vec<f64>
     }
 }
 
+/// The area of the cells whose pressure `p` is at the cap `hardness`
+/// ([`limit_per_cell`]), their covered part on cut cells, m²: the
+/// normal solver's plastic zone to the bit. One place for a case's and a
+/// load history's increments' plastic area.
+pub fn area_at_cap(hardness: f64, cover: Option<&[f64]>, p: &[f64], da: f64) -> f64 {
+    let caps = limit_per_cell(hardness, cover, p.len());
+    let capped: Vec<bool> = p
+        .iter()
+        .zip(&caps)
+        .map(|(&v, &c)| v > 0.0 && v >= c)
+        .collect();
+    crate::base::geometry::covered_area(&capped, cover, da)
+}
+
 impl Limits {
     /// The limits of the interface between two bodies: the smaller of each
     /// (the softer surface yields first).

@@ -428,10 +428,7 @@ pub(crate) fn reduce(
         plastic: None,
     };
     if let Some(hardness) = spec.limits().hardness {
-        // The cells at the cap, the normal solver's to the bit.
-        let caps = crate::model::material::limit_per_cell(hardness, cover, len);
-        let capped: Vec<bool> = (0..len).map(|i| p[i] > 0.0 && p[i] >= caps[i]).collect();
-        let area = covered_area(&capped, cover, da);
+        let area = crate::model::material::area_at_cap(hardness, cover, &p, da);
         s.plastic = Some(PlasticScalars {
             hardness_pa: hardness,
             plastic_area_m2: area,

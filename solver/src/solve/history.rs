@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::geometry::covered_area;
 use crate::error::SolverError;
-use crate::model::material::limit_per_cell;
+use crate::model::material::area_at_cap;
 use crate::model::radii::{apparent_radius, friction_reserve};
 use crate::model::spec::{CaseSpec, LoadHistory};
 use crate::model::surface::Terrain;
@@ -690,13 +690,10 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
         stick_radius_m: stick_radius,
         dissipated_j: sums.dissipated,
         worn_volume_m3: 0.0,
-        plastic_area_m2: spec.limits().hardness.map(|hardness| {
-            // The cells at the cap, as the case's `plastic_area_m2`.
-            let cover = terrain.cover.as_deref();
-            let caps = limit_per_cell(hardness, cover, len);
-            let capped: Vec<bool> = (0..len).map(|i| p[i] > 0.0 && p[i] >= caps[i]).collect();
-            covered_area(&capped, cover, da)
-        }),
+        plastic_area_m2: spec
+            .limits()
+            .hardness
+            .map(|hardness| area_at_cap(hardness, terrain.cover.as_deref(), p, da)),
         plastic_penetration_max_m: None,
         converged: sums.converged,
     }
