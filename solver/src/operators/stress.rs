@@ -1345,7 +1345,7 @@ impl StressPlan {
             components,
         };
         if plane.depth_m == 0.0 {
-            surface_tractions_exact(&mut field, t, self);
+            surface_tractions_exact(&mut field, t);
         }
         field
     }
@@ -1446,12 +1446,6 @@ impl StressPlan {
             surface_tractions_on_line(&mut field, t, line, n);
         }
         field
-    }
-
-    /// True when the plane at `depth_m` sums aliases (within
-    /// `ALIAS_FREE_DEPTH_CELLS` of the surface): a near field of its own.
-    pub fn sums_aliases(&self, depth_m: f64) -> bool {
-        self.aliases(depth_m, NEAR_ALIASES) > 0
     }
 
     /// [`StressPlan::image_spectra`] at depth `z`, computed once per plan.
@@ -1823,11 +1817,6 @@ impl StressPlan {
         }
         Ok(out)
     }
-
-    /// `qx, qy, p` of a state.
-    fn traction_fields(&self, t: &TractionSpectra) -> [Vec<f64>; 3] {
-        t.fields.clone()
-    }
 }
 
 /// The plane as it was built before issue #51, the tests' oracle: every
@@ -1942,8 +1931,8 @@ impl Images {
 /// themselves: `σzz = −p`, `σxz = −qx`, `σyz = −qy` in each cell (z into
 /// the body; the traction on the body is `−σ·e_z`). The transform of the
 /// cell's step would converge to them only slowly.
-fn surface_tractions_exact(field: &mut StressField, t: &TractionSpectra, plan: &mut StressPlan) {
-    let [qx, qy, p] = plan.traction_fields(t);
+fn surface_tractions_exact(field: &mut StressField, t: &TractionSpectra) {
+    let [qx, qy, p] = &t.fields;
     for i in 0..field.len() {
         field.components[2][i] = -p[i];
         field.components[3][i] = -qy[i];
