@@ -11,7 +11,7 @@ use common::axisym::disc_pressure;
 use common::LOAD_1A;
 use nalgebra::{DMatrix, DVector};
 use solver::normal::{solve_normal, NormalCache, NormalProblem, NormalSolution};
-use solver::{solve_case, KernelCache, Limits, LoadHistory, Operator};
+use solver::{solve_case, CaseSpec, KernelCache, Limits, LoadHistory, Operator};
 use std::f64::consts::PI;
 
 /// Table 1a: Fe under an 18 mm sphere.
@@ -388,6 +388,22 @@ fn a_sphere_between_the_limits_agrees_with_the_ring_reference() {
     assert!(fine.3 < coarse.3, "pressure: {} → {}", coarse.3, fine.3);
 }
 
+/// Table 1(a) Fe on 128² of 3 µm (`coupled` or not) with a hardness of
+/// 0.7 p0, which caps the Hertz peak: the cap and the case.
+fn capped_at_0_7_p0(coupled: bool) -> (f64, CaseSpec) {
+    let (_, p0) = hertz();
+    let cap = 0.7 * p0;
+    let mut spec = common::table_1a_fe(128, 3.0, coupled, 0.0);
+    spec.material = spec
+        .material
+        .with_limits(Limits {
+            hardness: Some(cap),
+            shear_limit: None,
+        })
+        .unwrap();
+    (cap, spec)
+}
+
 #[test]
 fn unloading_keeps_the_dent_and_reloading_does_not_yield_again() {
     // A normal load path P → P/10 → P at F = 0 on a surface whose hardness
@@ -396,16 +412,7 @@ fn unloading_keeps_the_dent_and_reloading_does_not_yield_again() {
     // to P finds the dented surface and the same pressure, with no further
     // plastic flow (elastic shakedown of a perfectly plastic surface under
     // a repeated normal load).
-    let (_, p0) = hertz();
-    let cap = 0.7 * p0;
-    let mut spec = common::table_1a_fe(128, 3.0, false, 0.0);
-    spec.material = spec
-        .material
-        .with_limits(Limits {
-            hardness: Some(cap),
-            shear_limit: None,
-        })
-        .unwrap();
+    let (cap, spec) = capped_at_0_7_p0(false);
     let mut cache = KernelCache::new();
     let once = solve_case(&spec, &mut cache).unwrap();
     let first = once.scalars.plastic.expect("a plastic zone");
@@ -506,16 +513,7 @@ fn a_fretting_path_on_a_capped_sphere_reports_its_plastic_area_and_a_dent_that_n
     // caps the Hertz peak: every row at the peak load has cells at the cap,
     // and the dent's deepest cell never decreases along the path (the
     // plastic penetration is permanent); the last row's is the case's.
-    let (_, p0) = hertz();
-    let cap = 0.7 * p0;
-    let mut spec = common::table_1a_fe(128, 3.0, true, 0.0);
-    spec.material = spec
-        .material
-        .with_limits(Limits {
-            hardness: Some(cap),
-            shear_limit: None,
-        })
-        .unwrap();
+    let (_, mut spec) = capped_at_0_7_p0(true);
     spec.history = Some(LoadHistory {
         tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
         normal_forces_n: Some(vec![LOAD_1A, LOAD_1A, 0.5 * LOAD_1A, LOAD_1A]),
