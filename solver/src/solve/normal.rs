@@ -670,24 +670,10 @@ fn plastic_zone(
         if !rep.converged {
             break;
         }
-        // The approach of the elastic part, from the total displacement.
-        let gap = |i: usize| h[i] + u[i];
-        let (mut s, mut nc) = (0.0, 0usize);
-        for i in 0..len {
-            if !zone[i] && p[i] > 0.0 {
-                s += gap(i);
-                nc += 1;
-            }
-        }
-        let approach = s / nc.max(1) as f64;
-        // A cell on the zone's edge after a reloading sits at its cap with
-        // its gap closed, both to round-off: the slack keeps it from
-        // joining and leaving in turn (a dented surface reloaded cycled
-        // for 100 updates without it).
-        let reach = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let (lift, _) = lift_off(h, u, p, &zone);
         let (mut joined, mut left) = (0usize, 0usize);
         for i in 0..len {
-            if zone[i] && gap(i) > approach + ZONE_SLACK * reach {
+            if zone[i] && h[i] + u[i] > lift {
                 // Lifted off its cap: back to the elastic contact.
                 zone[i] = false;
                 left += 1;
@@ -936,19 +922,30 @@ fn capped_cg(
     if report.converged {
         // Converged only if no zone cell stands above the indenter (the
         // release test of the next iteration).
-        let (mut nc, mut sg) = (0usize, 0.0);
-        for i in 0..len {
-            if !zone[i] && p[i] > 0.0 {
-                nc += 1;
-                sg += u[i] + h[i];
-            }
-        }
-        let gbar = sg / nc.max(1) as f64;
-        let reach = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        report.converged =
-            nc > 0 && (0..len).all(|i| !zone[i] || u[i] + h[i] <= gbar + ZONE_SLACK * reach);
+        let (lift, nc) = lift_off(h, u, p, zone);
+        report.converged = nc > 0 && (0..len).all(|i| !zone[i] || h[i] + u[i] <= lift);
     }
     Ok(report)
+}
+
+/// The height of the surface (`h + u`) above which a cell of the plastic
+/// `zone` has lifted off its cap: the approach of the elastic part (the
+/// mean gap of its contact cells) plus `ZONE_SLACK` of the largest
+/// displacement; and the number of those contact cells. A cell on the
+/// zone's edge after a reloading sits at its cap with its gap closed,
+/// both to round-off: the slack keeps it from joining and leaving in turn
+/// (a dented surface reloaded cycled for 100 updates without it).
+fn lift_off(h: &[f64], u: &[f64], p: &[f64], zone: &[bool]) -> (f64, usize) {
+    let (mut s, mut nc) = (0.0, 0usize);
+    for i in 0..h.len() {
+        if !zone[i] && p[i] > 0.0 {
+            s += h[i] + u[i];
+            nc += 1;
+        }
+    }
+    let approach = s / nc.max(1) as f64;
+    let reach = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    (approach + ZONE_SLACK * reach, nc)
 }
 
 /// Gives the cells outside the contact set that interpenetrate (`g < 0`,
