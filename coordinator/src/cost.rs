@@ -125,16 +125,7 @@ pub fn stress_sweep_seconds<'a>(
     cfg: &crate::config::StressCfg,
     workers: usize,
 ) -> f64 {
-    let mut materials: Vec<(&CaseSpec, usize)> = Vec::new();
-    for spec in specs.clone() {
-        match materials
-            .iter_mut()
-            .find(|(s, _)| s.material == spec.material)
-        {
-            Some((_, cases)) => *cases += 1,
-            None => materials.push((spec, 1)),
-        }
-    }
+    let materials = crate::memory::sweep_materials(specs.clone());
     let builds: f64 = materials
         .iter()
         .map(|(spec, cases)| stress_build_seconds(spec, cfg) * workers.min(*cases).max(1) as f64)

@@ -58,16 +58,23 @@ pub fn stress_bytes(
     kernels + cells * (256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
 }
 
-/// The materials (with their ball) a sweep's stresses are computed on: a
-/// worker keeps depth kernels for each (`stress_bytes`).
-pub fn stress_materials<'a>(specs: impl Iterator<Item = &'a solver::CaseSpec>) -> usize {
-    let mut seen: Vec<&solver::Material> = Vec::new();
-    for s in specs {
-        if !seen.contains(&&s.material) {
-            seen.push(&s.material);
+/// The materials of a sweep's `specs`, each with its first case and its
+/// number of cases: a worker keeps depth kernels for each
+/// (`stress_bytes`), and builds them once (`cost::stress_sweep_seconds`).
+pub fn sweep_materials<'a>(
+    specs: impl Iterator<Item = &'a solver::CaseSpec>,
+) -> Vec<(&'a solver::CaseSpec, usize)> {
+    let mut materials: Vec<(&solver::CaseSpec, usize)> = Vec::new();
+    for spec in specs {
+        match materials
+            .iter_mut()
+            .find(|(s, _)| s.material == spec.material)
+        {
+            Some((_, cases)) => *cases += 1,
+            None => materials.push((spec, 1)),
         }
     }
-    seen.len()
+    materials
 }
 
 /// The most states a case of `cases` has its stresses computed at (the
