@@ -505,38 +505,24 @@ pub fn compute_with(
         })
         .collect();
     // One kernel per depth, applied to every state.
-    // The slices: the rows below the surface all at once
-    // (`StressPlan::slice`, no plane built), the surface's from its plane
-    // (kept for SWT).
-    let direct: Vec<bool> = slice_depths.iter().map(|&z| z != 0.0).collect();
-    let deep: Vec<f64> = slice_depths
-        .iter()
-        .zip(&direct)
-        .filter_map(|(&z, &d)| d.then_some(z))
-        .collect();
-    let deep_rows = if deep.is_empty() {
-        Vec::new()
-    } else {
-        plan.slice(&deep, &tractions, &[along, across])?
-    };
-    let mut next_deep = 0;
-    for &direct in &direct {
-        if direct {
-            for (s, rows) in out.iter_mut().zip(&deep_rows) {
-                s.along.push(rows[0][next_deep].clone());
-                s.across.push(rows[1][next_deep].clone());
-            }
-            next_deep += 1;
-            continue;
-        }
-        // The slices' top row is the surface plane's, kept for SWT.
+    // The slices: their top row (z = 0) from the surface plane kept for
+    // SWT, the rows below it all at once (`StressPlan::slice`, no plane
+    // built).
+    if let Some((_, below)) = slice_depths.split_first() {
         let plane = resolve(&surface_plane, kept);
         for (s, t) in out.iter_mut().zip(&tractions) {
             s.along.push(plan.apply_line(plane, t, along));
             s.across.push(plan.apply_line(plane, t, across));
         }
+        if !below.is_empty() {
+            let rows = plan.slice(below, &tractions, &[along, across])?;
+            for (s, lines) in out.iter_mut().zip(rows) {
+                let [a, c]: [Vec<StressField>; 2] = lines.try_into().expect("two lines asked");
+                s.along.extend(a);
+                s.across.extend(c);
+            }
+        }
     }
-    let mut surface: Option<Vec<StressField>> = None;
     for r in &depth_planes {
         let plane = resolve(r, kept);
         for (s, t) in out.iter_mut().zip(&tractions) {
@@ -545,10 +531,10 @@ pub fn compute_with(
     }
     // The surface plane for SWT: a plane of the request at z = 0, else its own.
     let on_surface = depths_m.iter().position(|&z| z == 0.0);
-    if on_surface.is_none() {
+    let surface: Option<Vec<StressField>> = on_surface.is_none().then(|| {
         let plane = resolve(&surface_plane, kept);
-        surface = Some(tractions.iter().map(|t| plan.apply(plane, t)).collect());
-    }
+        tractions.iter().map(|t| plan.apply(plane, t)).collect()
+    });
     let surface_of = |k: usize| -> &StressField {
         match (&surface, on_surface) {
             (Some(s), _) => &s[k],
