@@ -37,11 +37,12 @@ const INCREMENT_COST: f64 = 0.6;
 /// an increment uncoupled against a coupled monotonic solve's 0.44 s).
 const WEAR_INCREMENT_COST: f64 = 0.09;
 
-/// A case on a surface with a hardness costs about 1.5 elastic ones: the
-/// paper's Table 1(c) surfaces at 512² took 1.37× the elastic sweep's time
-/// with H = 0.9 GPa and 1.56–1.77× with 0.5 GPa with the capped CG (2.0–3.4×
-/// before it; docs/performance.md, "A capped surface").
-const CAPPED_COST: f64 = 1.5;
+/// A case on a surface with a hardness costs about 1.3 elastic ones: the
+/// paper's Table 1(c) surfaces at 512² took 1.17× the elastic sweep's time
+/// with H = 0.9 GPa and 1.33× with 0.5 GPa (fastest of 4 rounds,
+/// `bench/capped.sh`; 2.0–3.4× before the capped CG, 1.4–1.7× before it
+/// kept one displacement; docs/performance.md, "A capped surface").
+const CAPPED_COST: f64 = 1.3;
 
 /// Expected seconds of one case on one worker.
 pub fn case_seconds(spec: &CaseSpec) -> f64 {

@@ -145,3 +145,35 @@ fn the_active_set_iteration_is_bit_identical_on_1_2_and_3_threads() {
         assert!(one.scalars.converged, "coupling {coupling}");
     }
 }
+
+/// A surface with a hardness (issue #50): the capped conjugate gradient's
+/// passes run over the same fixed pieces, so a coupled partial-slip case
+/// whose plastic zone spans several pieces (64² of 4.5 µm, H = 0.7 p0 of
+/// Hertz's peak) is the same bits on 1, 2 and 3 threads.
+#[test]
+fn a_capped_coupled_case_is_bit_identical_on_1_2_and_3_threads() {
+    let mut spec = table_1a_fe(64, 4.5, true, 0.6);
+    let load = spec.load.normal_force_n;
+    let (e_star, r) = (210.0e9 / (1.0 - 0.3 * 0.3), 18.0e-3);
+    let a = (3.0 * load * r / (4.0 * e_star)).cbrt();
+    let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+    spec.material = spec
+        .material
+        .with_limits(solver::Limits {
+            hardness: Some(0.7 * p0),
+            shear_limit: None,
+        })
+        .unwrap();
+    let one = same_on_1_2_and_3_threads(&spec, true);
+    assert!(one.scalars.converged);
+    let capped = one.fields.p.iter().filter(|&&v| v >= 0.7 * p0).count();
+    assert!(
+        capped > 1024,
+        "a plastic zone over several pieces: {capped} cells"
+    );
+    let (stuck, contact) = partial_slip(&one);
+    assert!(
+        stuck > 0 && stuck < contact,
+        "partial slip: {stuck} of {contact}"
+    );
+}
