@@ -1998,3 +1998,93 @@ fn a_worn_sweep_resumes_to_the_same_curves_and_wear_tables() {
     assert_eq!(tables, CASES);
     assert!(shm_leftovers("w").is_empty());
 }
+
+/// Issue 50 in sweeps: Cu with a hardness of 0.6 GPa over two workers
+/// (48² of 200 µm, flat and circle-B, 0° and 90°). results.csv gains the
+/// plastic columns and curves.csv the plastic area; every case's pressure
+/// peaks at H exactly and the load lies between H times the area at the cap
+/// and H times the contact area; and a case's plastic scalars and μa are
+/// `mpcontact solve`'s to the bit.
+#[test]
+fn issue50_a_sweep_with_a_hardness_reports_the_plastic_zone_of_solve() {
+    let d = scratch("hardness");
+    let config = concat!(
+        "[grid]\npoints = 48\nspacing_um = 200.0\n\n",
+        "[indenter]\nradius_mm = 200.0\n\n",
+        "[load]\nnormal_n = 6000.0\nfriction = 0.3\ntangential_ratio = 0.3\n\n",
+        "[sweep]\nmaterials = [\"Cu\"]\nsurfaces = [\"flat\", \"circle-B\"]\nangles_deg = [0.0, 90.0]\n\n",
+        "[materials.Cu]\nhardness_gpa = 0.6\n\n",
+        "[solver]\ncoupling = false\ntolerance = 1e-6\nmax_iterations = 2000\n",
+    );
+    std::fs::write(d.join("sweep.toml"), config).unwrap();
+    check_ok(
+        &sweep_cmd(&d, "out", 2, "hd").output().unwrap(),
+        "sweep with a hardness",
+    );
+    let out = d.join("out");
+    let rows = read_csv(&out.join("results.csv"));
+    assert_eq!(
+        rows[0].join(","),
+        format!(
+            "{},{}",
+            coordinator::run::RESULTS_HEADER,
+            coordinator::run::RESULTS_PLASTIC_COLUMNS
+        )
+    );
+    assert_eq!(rows.len(), 5, "four cases");
+    let col = |name: &str| rows[0].iter().position(|h| h == name).unwrap();
+    let num = |r: &[String], name: &str| r[col(name)].parse::<f64>().unwrap();
+    let (h, load) = (0.6e9, 6000.0);
+    for r in &rows[1..] {
+        assert_eq!(r[col("status")], "ok", "{r:?}");
+        assert_eq!(num(r, "hardness_pa"), h);
+        assert_eq!(num(r, "p_max_pa"), h, "the peak is the cap: {r:?}");
+        let (plastic, contact) = (num(r, "plastic_area_m2"), num(r, "contact_area_m2"));
+        assert!(plastic > 0.0, "{r:?}");
+        assert!(h * plastic <= load * (1.0 + 1e-12), "H·A_H ≤ P: {r:?}");
+        assert!(load <= h * contact * (1.0 + 1e-12), "P ≤ H·A: {r:?}");
+        assert!(num(r, "dent_volume_m3") > 0.0 && num(r, "plastic_penetration_max_m") > 0.0);
+    }
+    let curves = read_csv(&out.join("curves.csv"));
+    assert!(curves[0]
+        .join(",")
+        .ends_with(coordinator::run::CURVES_PLASTIC_COLUMNS));
+    assert!(out.join("mu_a_vs_angle.png").exists());
+    // circle-B at 90° through `mpcontact solve`: the same bits.
+    let s = d.join("solve");
+    let o = Command::new(EXE)
+        .arg("solve")
+        .arg(d.join("sweep.toml"))
+        .args([
+            "--surface",
+            "circle-B",
+            "--angle-deg",
+            "90",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&s)
+        .output()
+        .unwrap();
+    check_ok(&o, "solve");
+    let case: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.join("case.json")).unwrap()).unwrap();
+    let row = rows[1..]
+        .iter()
+        .find(|r| r[col("surface")] == "circle-B" && r[col("angle_deg")] == "90")
+        .unwrap();
+    let bits = |cell: &str| cell.parse::<f64>().unwrap().to_bits();
+    let json_bits = |v: &serde_json::Value| v.as_f64().unwrap().to_bits();
+    for (name, v) in [
+        ("mu_a", &case["mu_a"]),
+        ("plastic_area_m2", &case["plastic"]["plastic_area_m2"]),
+        ("plastic_radius_m", &case["plastic"]["plastic_radius_m"]),
+        (
+            "plastic_penetration_max_m",
+            &case["plastic"]["penetration_max_m"],
+        ),
+        ("dent_volume_m3", &case["plastic"]["dent_volume_m3"]),
+    ] {
+        assert_eq!(bits(&row[col(name)]), json_bits(v), "{name}");
+    }
+}

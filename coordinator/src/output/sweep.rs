@@ -603,8 +603,10 @@ fn panels_of(
 /// material, one series per surface with markers at the computed angles
 /// and error bars where a ladder gave them, the flat surface in black; and,
 /// when a material's K_E was calibrated on its flat surface, a panel of
-/// K_E(ψ) (GPa) for those materials; with `[stress]`, a panel per material
-/// of the largest von Mises stress over p_H. The legend sits beside the panels.
+/// K_E(ψ) (GPa) for those materials; on a surface with a hardness, a panel
+/// per material of the area at the hardness (mm²); with `[stress]`, a panel
+/// per material of the largest von Mises stress over p_H. The legend sits
+/// beside the panels.
 pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
     let mut k_e = Panel {
@@ -662,9 +664,14 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
             Some((l.over_p_h, None))
         },
     );
+    // On a surface with a hardness: the area at the cap, in mm².
+    let plastic = panels_of(points, "area at the hardness", "plastic area (mm²)", |p| {
+        Some((p.plastic?.plastic_area_m2 * 1e6, None))
+    });
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     panels.extend(energy);
     panels.extend(worn);
+    panels.extend(plastic);
     panels.extend(stress);
     if !k_e.series.is_empty() {
         panels.push(k_e);

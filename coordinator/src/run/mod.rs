@@ -31,7 +31,8 @@ use serde::Serialize;
 pub use crate::output::fretting_map::{FRETTING_MAP_HEADER, TRANSITIONS_HEADER};
 pub use crate::output::orientation_map::ORIENTATIONS_HEADER;
 pub use crate::output::sweep::{
-    CURVES_HEADER, CURVES_STRESS_COLUMNS, RESULTS_HEADER, RESULTS_STRESS_COLUMNS,
+    CURVES_HEADER, CURVES_PLASTIC_COLUMNS, CURVES_STRESS_COLUMNS, RESULTS_HEADER,
+    RESULTS_PLASTIC_COLUMNS, RESULTS_STRESS_COLUMNS,
 };
 pub use exchange::Interrupted;
 pub use journal::{Entry, Journal, Line, Outcome, JOURNAL_FILE};
