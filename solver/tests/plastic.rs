@@ -560,3 +560,92 @@ fn a_fretting_path_on_a_capped_sphere_reports_its_plastic_area_and_a_dent_that_n
         .iter()
         .all(|r| r.plastic_area_m2.is_none() && r.plastic_penetration_max_m.is_none()));
 }
+
+/// The cap on a crystal, on an elastic ball and in the stresses (issue #50's
+/// "works with"): Fe(111) with H = 0.4 p0 (p0 of the rigid sphere on Fe),
+/// and a Fe substrate without a hardness under a Fe ball that has one (the
+/// softer body's H caps the interface). In each the pressure peaks at H
+/// exactly, the load lies between H times the area at the cap and H
+/// times the contact area, and a dent is kept; the crystal's stresses are
+/// those of the capped tractions: on the surface plane σzz = −p (the
+/// traction the plane carries, to round-off), so −H on the plastic zone.
+#[test]
+fn a_crystal_an_elastic_ball_and_the_stresses_see_the_cap() {
+    let (_, p0) = hertz();
+    let cap = 0.4 * p0;
+    let limits = Limits {
+        hardness: Some(cap),
+        shear_limit: None,
+    };
+    let base = common::table_1a_fe(64, 4.5, false, 0.3);
+    let mut crystal = base.clone();
+    crystal.material = solver::presets::material("Fe(111)")
+        .unwrap()
+        .with_limits(limits)
+        .unwrap();
+    let mut ball = base.clone();
+    ball.indenter = Some(
+        solver::presets::material("Fe")
+            .unwrap()
+            .with_limits(limits)
+            .unwrap(),
+    );
+    assert_eq!(ball.limits().hardness, Some(cap), "the ball's H");
+    let da = base.grid.cell_area();
+    for (what, spec) in [("Fe(111)", &crystal), ("Fe ball", &ball)] {
+        let out = solve_case(spec, &mut KernelCache::new()).unwrap();
+        assert!(out.scalars.converged, "{what}");
+        let p = &out.fields.p;
+        let pmax = p.iter().cloned().fold(0.0, f64::max);
+        assert_eq!(pmax, cap, "{what}: the peak is the cap");
+        let at_cap = p.iter().filter(|&&v| v >= cap).count() as f64 * da;
+        let contact = p.iter().filter(|&&v| v > 0.0).count() as f64 * da;
+        assert!(
+            at_cap > 0.0 && at_cap < contact,
+            "{what}: {at_cap} of {contact}"
+        );
+        assert!(cap * at_cap <= LOAD_1A * (1.0 + 1e-12), "{what}: H·A_H ≤ P");
+        assert!(LOAD_1A <= cap * contact * (1.0 + 1e-12), "{what}: P ≤ H·A");
+        let dent = out.fields.plastic.iter().cloned().fold(0.0, f64::max);
+        assert!(dent > 0.0, "{what}: a dent");
+        eprintln!(
+            "{what}: A_H = {at_cap:.4e} m², A = {contact:.4e} m², P/H = {:.4e} m², dent {dent:.3e} m",
+            LOAD_1A / cap
+        );
+        if what == "Fe(111)" {
+            let req = solver::stress_summary::StressRequest {
+                depths_m: vec![0.0],
+                slices: false,
+                slice_depth_m: None,
+                slice_rows: 2,
+                turning_states: false,
+                crossland_alpha: 0.0,
+            };
+            let st = solver::stress_summary::compute(
+                &req,
+                spec,
+                &out.scalars,
+                &out.fields,
+                &out.turning,
+            )
+            .unwrap();
+            let szz = &st.states[0].planes[0].components[2];
+            let err = (0..p.len())
+                .map(|i| (szz[i] + p[i]).abs())
+                .fold(0.0, f64::max);
+            eprintln!(
+                "{what}: max |σzz + p| = {:.2e} p0 on the surface plane",
+                err / p0
+            );
+            assert!(err < 1e-9 * p0, "σzz + p up to {:e} p0", err / p0);
+            let capped_min = (0..p.len())
+                .filter(|&i| p[i] >= cap)
+                .map(|i| -szz[i])
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                capped_min > cap - 2e-4 * p0,
+                "σzz on the zone: {capped_min:e}"
+            );
+        }
+    }
+}
