@@ -274,18 +274,35 @@ struct Level<'a> {
     cap: Option<&'a [f64]>,
 }
 
-/// One grid's normal solve: [`polonsky_keer`], or around it the plastic
-/// zone of [`plastic_zone`] when the level has caps.
+/// One grid's normal solve: [`polonsky_keer`], or with caps the plastic
+/// zone of [`plastic_zone`]. A start with no cell at its cap (a contact from
+/// rest, a warm start that did not yield) is first solved elastically, and
+/// the capped solve goes on from there only if that pressure exceeds a cap
+/// somewhere: a hardness the contact never reaches changes nothing, to the
+/// bit (the same Polonsky–Keer iterations as without it).
 fn solve_level(
     op: &mut impl ZzApply,
     level: &Level,
     p: &mut [f64],
     u: &mut [f64],
 ) -> Result<NormalReport, SolverError> {
-    match level.cap {
-        Some(cap) => plastic_zone(op, level, cap, p, u),
-        None => polonsky_keer(op, level, p, u),
+    let Some(cap) = level.cap else {
+        return polonsky_keer(op, level, p, u);
+    };
+    if p.iter()
+        .zip(cap)
+        .any(|(&v, &c)| v >= c * (1.0 - ZONE_START))
+    {
+        return plastic_zone(op, level, cap, p, u);
     }
+    let elastic = polonsky_keer(op, level, p, u)?;
+    if !p.iter().zip(cap).any(|(&v, &c)| v > c) {
+        return Ok(elastic);
+    }
+    let mut report = plastic_zone(op, level, cap, p, u)?;
+    report.iterations += elastic.iterations;
+    report.applications += elastic.applications;
+    Ok(report)
 }
 
 /// Iterations after which `u = K p` is recomputed even if it could be updated.
