@@ -38,8 +38,8 @@ const INCREMENT_COST: f64 = 0.6;
 const WEAR_INCREMENT_COST: f64 = 0.09;
 
 /// A case on a surface with a hardness costs about 1.3 elastic ones: the
-/// paper's Table 1(c) surfaces at 512² took 1.17× the elastic sweep's time
-/// with H = 0.9 GPa and 1.33× with 0.5 GPa (fastest of 4 rounds,
+/// paper's Table 1(c) surfaces at 512² took 1.19× the elastic sweep's time
+/// with H = 0.9 GPa and 1.36× with 0.5 GPa (fastest of 4 rounds,
 /// `bench/capped.sh`; 2.0–3.4× before the capped CG, 1.4–1.7× before it
 /// kept one displacement; docs/performance.md, "A capped surface").
 const CAPPED_COST: f64 = 1.3;
