@@ -400,7 +400,14 @@ fn a_sphere_between_the_limits_agrees_with_the_ring_reference() {
 fn capped_at_0_7_p0(coupled: bool) -> (f64, CaseSpec) {
     let (_, p0) = hertz();
     let cap = 0.7 * p0;
-    let mut spec = common::table_1a_fe(128, 3.0, coupled, 0.0);
+    (
+        cap,
+        with_hardness(common::table_1a_fe(128, 3.0, coupled, 0.0), cap),
+    )
+}
+
+/// `spec` with its substrate's hardness set to `cap` (Pa).
+fn with_hardness(mut spec: CaseSpec, cap: f64) -> CaseSpec {
     spec.material = spec
         .material
         .with_limits(Limits {
@@ -408,7 +415,7 @@ fn capped_at_0_7_p0(coupled: bool) -> (f64, CaseSpec) {
             shear_limit: None,
         })
         .unwrap();
-    (cap, spec)
+    spec
 }
 
 #[test]
@@ -670,14 +677,7 @@ fn a_hardness_above_the_contact_changes_no_bit_of_a_case() {
     let pmax = elastic.fields.p.iter().cloned().fold(0.0, f64::max);
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     for cap in [1.5 * pmax, 1e3 * pmax] {
-        let mut spec = elastic_spec.clone();
-        spec.material = spec
-            .material
-            .with_limits(Limits {
-                hardness: Some(cap),
-                shear_limit: None,
-            })
-            .unwrap();
+        let spec = with_hardness(elastic_spec.clone(), cap);
         let out = solve_case(&spec, &mut KernelCache::new()).unwrap();
         let (a, b) = (&out.scalars, &elastic.scalars);
         assert_eq!(
