@@ -20,8 +20,7 @@ const NU: f64 = 0.3;
 const R: f64 = 18.0e-3;
 
 fn hertz() -> (f64, f64) {
-    let a = (3.0 * LOAD_1A * R / (4.0 * E / (1.0 - NU * NU))).cbrt();
-    (a, 3.0 * LOAD_1A / (2.0 * PI * a * a))
+    common::hertz_1a()
 }
 
 fn solve(op: &mut Operator, h: &[f64], load: f64, hardness: Option<f64>) -> NormalSolution {

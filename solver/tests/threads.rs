@@ -153,10 +153,7 @@ fn the_active_set_iteration_is_bit_identical_on_1_2_and_3_threads() {
 #[test]
 fn a_capped_coupled_case_is_bit_identical_on_1_2_and_3_threads() {
     let mut spec = table_1a_fe(64, 4.5, true, 0.6);
-    let load = spec.load.normal_force_n;
-    let (e_star, r) = (210.0e9 / (1.0 - 0.3 * 0.3), 18.0e-3);
-    let a = (3.0 * load * r / (4.0 * e_star)).cbrt();
-    let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+    let (_, p0) = common::hertz_1a();
     spec.material = spec
         .material
         .with_limits(solver::Limits {

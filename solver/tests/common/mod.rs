@@ -94,6 +94,14 @@ pub const LOAD_1A: f64 = 20.0;
 /// See [`LOAD_1A`].
 pub const MU_1A: f64 = 0.28571;
 
+/// Hertz's contact radius (m) and peak pressure (Pa) of Table 1a (Fe,
+/// E = 210 GPa, ν = 0.3, rigid sphere of 18 mm, P = [`LOAD_1A`]).
+pub fn hertz_1a() -> (f64, f64) {
+    let e_star = 210.0e9 / (1.0 - 0.3 * 0.3);
+    let a = (3.0 * LOAD_1A * 18.0e-3 / (4.0 * e_star)).cbrt();
+    (a, 3.0 * LOAD_1A / (2.0 * std::f64::consts::PI * a * a))
+}
+
 /// Fe (E = 210 GPa, ν = 0.3) under a sphere of 18 mm: the operator of an
 /// `n x n` grid of cell `d` and the sphere's separation on it.
 pub fn fe_sphere(n: usize, d: f64) -> (Operator, Vec<f64>) {
