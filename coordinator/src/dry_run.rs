@@ -50,9 +50,7 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         }
     }
     let stress_bytes = config.stress.as_ref().map_or(0.0, |cfg| {
-        let states = crate::memory::stress_states(cfg, cases.iter().map(|(_, s)| s));
-        let materials = crate::memory::sweep_materials(cases.iter().map(|(_, s)| s)).len();
-        crate::memory::stress_bytes(n, cfg, states, materials)
+        crate::memory::stress_bytes(n, cfg, cases.iter().map(|(_, s)| s))
     });
     let per_worker = crate::memory::worker_bytes(n, kernels.len()) + stress_bytes;
     crate::memory::check_fits(

@@ -37,13 +37,16 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
 /// 256², Fe and Fe(111), one state, two planes and 41 slice rows (Table
 /// 1(a) with `[stress]`): 307 MB with the solve's kernels, 355 MB peak RSS
 /// measured of a worker of `mpcontact run --workers 2` (issue #51,
-/// docs/performance.md; the allocator's slack is not counted).
-pub fn stress_bytes(
+/// docs/performance.md; the allocator's slack is not counted). The states
+/// and materials are those of the cases `specs` (`stress_states`,
+/// `sweep_materials`).
+pub fn stress_bytes<'a>(
     n: usize,
     cfg: &crate::config::StressCfg,
-    states: usize,
-    materials: usize,
+    specs: impl Iterator<Item = &'a solver::CaseSpec> + Clone,
 ) -> f64 {
+    let states = stress_states(cfg, specs.clone());
+    let materials = sweep_materials(specs).len();
     let cells = (n * n) as f64;
     let planes = (cfg.depths_um.len() + 1) as f64;
     let kernel = 576.0 * cells;
@@ -79,7 +82,7 @@ pub fn sweep_materials<'a>(
 
 /// The most states a case of `cases` has its stresses computed at (the
 /// turning points of a load history with `stress.states = "turning"`).
-pub fn stress_states<'a>(
+fn stress_states<'a>(
     cfg: &crate::config::StressCfg,
     specs: impl Iterator<Item = &'a solver::CaseSpec>,
 ) -> usize {

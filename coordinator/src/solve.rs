@@ -243,8 +243,7 @@ pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
         &format!("this case ({0} x {0} cells)", spec.grid.n),
         crate::memory::worker_bytes(spec.grid.n, 1)
             + case.stress.as_ref().map_or(0.0, |cfg| {
-                let states = crate::memory::stress_states(cfg, std::iter::once(spec));
-                crate::memory::stress_bytes(spec.grid.n, cfg, states, 1)
+                crate::memory::stress_bytes(spec.grid.n, cfg, std::iter::once(spec))
             }),
         1,
         crate::memory::available_bytes(),

@@ -117,9 +117,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let kernels: std::collections::HashSet<_> = plan.cases.iter().map(|c| &c.kernel_key).collect();
     let n = args.config.finest_points();
     let stress_bytes = args.config.stress.as_ref().map_or(0.0, |cfg| {
-        let states = crate::memory::stress_states(cfg, plan.cases.iter().map(|c| &c.spec));
-        let materials = crate::memory::sweep_materials(plan.cases.iter().map(|c| &c.spec)).len();
-        crate::memory::stress_bytes(n, cfg, states, materials)
+        crate::memory::stress_bytes(n, cfg, plan.cases.iter().map(|c| &c.spec))
     });
     crate::memory::check_fits(
         "the sweep",
