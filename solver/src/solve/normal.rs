@@ -279,15 +279,17 @@ struct Level<'a> {
 /// rest, a warm start that did not yield) is first solved elastically, and
 /// the capped solve goes on from there only if that pressure exceeds a cap
 /// somewhere: a hardness the contact never reaches changes nothing, to the
-/// bit (the same Polonsky–Keer iterations as without it).
+/// bit (the same Polonsky–Keer iterations as without it). The flag says
+/// whether `u` is `K p` of the returned `p` exactly (a converged capped
+/// CG's last application), so the caller need not apply `K` again.
 fn solve_level(
     op: &mut impl ZzApply,
     level: &Level,
     p: &mut [f64],
     u: &mut [f64],
-) -> Result<NormalReport, SolverError> {
+) -> Result<(NormalReport, bool), SolverError> {
     let Some(cap) = level.cap else {
-        return polonsky_keer(op, level, p, u);
+        return Ok((polonsky_keer(op, level, p, u)?, false));
     };
     if p.iter()
         .zip(cap)
@@ -297,12 +299,12 @@ fn solve_level(
     }
     let elastic = polonsky_keer(op, level, p, u)?;
     if !p.iter().zip(cap).any(|(&v, &c)| v > c) {
-        return Ok(elastic);
+        return Ok((elastic, false));
     }
-    let mut report = plastic_zone(op, level, cap, p, u)?;
+    let (mut report, fresh) = plastic_zone(op, level, cap, p, u)?;
     report.iterations += elastic.iterations;
     report.applications += elastic.applications;
-    Ok(report)
+    Ok((report, fresh))
 }
 
 /// Iterations after which `u = K p` is recomputed even if it could be updated.
@@ -495,21 +497,9 @@ fn polonsky_keer(
                 let k = i - part.start;
                 let old = p[k];
                 p_old[k] = old;
-                let mut new = if old > 0.0 {
-                    let v = old - tau * t[i];
-                    if v < 0.0 {
-                        clipped = true;
-                        0.0
-                    } else {
-                        v
-                    }
-                } else {
-                    0.0
-                };
-                if new == 0.0 && g[i] < 0.0 {
-                    new = -tau * g[i];
-                    overlap = true;
-                }
+                let (new, clip, admit) = step_cell(old, t[i], g[i], tau);
+                clipped |= clip;
+                overlap |= admit;
                 p[k] = new;
                 total += new;
             }
@@ -555,6 +545,33 @@ fn polonsky_keer(
     Ok(report)
 }
 
+/// One cell's Polonsky–Keer step of length `tau` along `t`: a cell in
+/// contact (`old > 0`) moves to `old − τt`, clipped at zero; a cell that
+/// ends out of contact but interpenetrates (`g < 0`, the gap less the
+/// contact's mean) is admitted at `−τg`. Returns the new pressure, whether
+/// it was clipped and whether admitted (the elastic and the capped
+/// iterations' step).
+#[inline]
+fn step_cell(old: f64, t: f64, g: f64, tau: f64) -> (f64, bool, bool) {
+    let mut clipped = false;
+    let mut new = if old > 0.0 {
+        let v = old - tau * t;
+        if v < 0.0 {
+            clipped = true;
+            0.0
+        } else {
+            v
+        }
+    } else {
+        0.0
+    };
+    let admitted = new == 0.0 && g < 0.0;
+    if admitted {
+        new = -tau * g;
+    }
+    (new, clipped, admitted)
+}
+
 /// Largest number of plastic-zone updates of a capped solve (each an
 /// elastic solve from the last); the zone of a sphere settles in a few.
 const MAX_ZONE_UPDATES: usize = 100;
@@ -589,14 +606,15 @@ const OUT_OF_REACH: f64 = 1e30;
 /// capped cells whose surface no longer reaches the indenter leave it,
 /// until neither happens. A cell in the zone is kept out of the elastic
 /// contact by the separation [`OUT_OF_REACH`]. On return `p` carries the
-/// caps on the zone and `u = K p`.
+/// caps on the zone and `u = K p`, exactly (from one application) when the
+/// flag is true, else summed from the zone's and the rest's.
 fn plastic_zone(
     op: &mut impl ZzApply,
     level: &Level,
     cap: &[f64],
     p: &mut [f64],
     u: &mut [f64],
-) -> Result<NormalReport, SolverError> {
+) -> Result<(NormalReport, bool), SolverError> {
     let Level { h, da, load_n, .. } = *level;
     let len = h.len();
     // The zone a warm start (or an interpolated coarse solution) had: the
@@ -624,7 +642,7 @@ fn plastic_zone(
     if rep.converged {
         report.converged = true;
         report.change = rep.change;
-        return Ok(report);
+        return Ok((report, true));
     }
     let mut settling = true;
     for _ in 0..MAX_ZONE_UPDATES {
@@ -707,7 +725,7 @@ fn plastic_zone(
             settling = false;
         }
     }
-    Ok(report)
+    Ok((report, false))
 }
 
 /// Budget of [`capped_cg`]'s iterations before the zone iteration takes over.
@@ -758,7 +776,11 @@ fn capped_cg(
     let mut g = vec![0.0; len];
     let mut t = vec![0.0; len];
     let mut r = vec![0.0; len];
-    let mut z = vec![0.0; len];
+    let mut z = if precondition {
+        vec![0.0; len]
+    } else {
+        Vec::new()
+    };
     let mut free = vec![false; len];
     let mut p_old = vec![0.0; len];
     let mut zone_old = vec![false; len];
@@ -921,21 +943,10 @@ fn capped_cg(
                     if zone[k] {
                         continue;
                     }
-                    let mut new = if free[i] {
-                        let v = p_old[i] - tau * t[i];
-                        if v < 0.0 {
-                            clipped = true;
-                            0.0
-                        } else {
-                            v
-                        }
-                    } else {
-                        0.0
-                    };
-                    if new == 0.0 && g[i] < 0.0 {
-                        new = -tau * g[i];
-                        overlap = true;
-                    }
+                    // (A cell outside the zone is free when it has pressure.)
+                    let (mut new, clip, admit) = step_cell(p_old[i], t[i], g[i], tau);
+                    clipped |= clip;
+                    overlap |= admit;
                     if new >= cap[i] {
                         new = cap[i];
                         zone[k] = true;
@@ -1184,7 +1195,7 @@ pub fn solve_normal(
                     // Levels are used once per nested start: no work
                     // spectra are kept between starts.
                     level.release_work();
-                    coarse_iterations += rep?.iterations;
+                    coarse_iterations += rep?.0.iterations;
                     let mut up = prolong(&pl, g.n);
                     up.iter_mut().for_each(|v| *v = v.max(0.0));
                     start = Some(up);
@@ -1214,12 +1225,15 @@ pub fn solve_normal(
     if let Some(pre) = &mut cache.precond {
         pre.release_work();
     }
-    let mut report = report?;
+    let (mut report, fresh) = report?;
     report.coarse_iterations = coarse_iterations;
-    // Final state and residuals from the returned pressure.
-    op.normal(&p, &mut u);
-    if let Some(layer) = layer {
-        add_layer(layer, &p, &mut u);
+    // Final state and residuals from the returned pressure (`u` is already
+    // `K p` after a converged capped CG).
+    if !fresh {
+        op.normal(&p, &mut u);
+        if let Some(layer) = layer {
+            add_layer(layer, &p, &mut u);
+        }
     }
     // The approach is the gap of the cells in elastic contact (below their
     // caps); with every contact cell capped, the largest capped gap.
