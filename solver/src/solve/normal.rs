@@ -291,10 +291,7 @@ fn solve_level(
     let Some(cap) = level.cap else {
         return Ok((polonsky_keer(op, level, p, u)?, false));
     };
-    if p.iter()
-        .zip(cap)
-        .any(|(&v, &c)| v >= c * (1.0 - ZONE_START))
-    {
+    if p.iter().zip(cap).any(|(&v, &c)| starts_capped(v, c)) {
         return plastic_zone(op, level, cap, p, u);
     }
     let elastic = polonsky_keer(op, level, p, u)?;
@@ -586,6 +583,12 @@ const ZONE_SLACK: f64 = 1e-9;
 /// round-off).
 const ZONE_START: f64 = 1e-6;
 
+/// A start's cell of pressure `p` at its cap `cap` ([`ZONE_START`]): it
+/// begins in the plastic zone, and a start with one is solved capped.
+fn starts_capped(p: f64, cap: f64) -> bool {
+    p >= cap * (1.0 - ZONE_START)
+}
+
 /// Tolerance of a capped solve's elastic solves while its plastic zone
 /// moves.
 const SETTLING_TOLERANCE: f64 = 1e-3;
@@ -621,9 +624,7 @@ fn plastic_zone(
     // coupling passes of a case and the increments of a path start next to
     // their zone (circle-B of the quick sweep: 7 updates in every pass
     // from an empty zone).
-    let mut zone: Vec<bool> = (0..len)
-        .map(|i| p[i] >= cap[i] * (1.0 - ZONE_START))
-        .collect();
+    let mut zone: Vec<bool> = (0..len).map(|i| starts_capped(p[i], cap[i])).collect();
     let mut report = NormalReport::default();
     let (mut p_zone, mut u_zone, mut h_in) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
     // While the zone moves, its elastic solves stop early (at 1e-4 the
