@@ -52,12 +52,11 @@ pub fn case_seconds(spec: &CaseSpec) -> f64 {
     }
     match &spec.history {
         Some(h) => {
-            let segments = h.turning_points(&spec.load).len().saturating_sub(1);
             let increment = match h.wear {
                 Some(_) => INCREMENT_COST + WEAR_INCREMENT_COST,
                 None => INCREMENT_COST,
             };
-            one * increment * (segments * h.steps_per_segment).max(1) as f64
+            one * increment * spec.expected_increments() as f64
         }
         None => one,
     }

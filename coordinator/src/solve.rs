@@ -165,8 +165,15 @@ impl CaseChoice {
         material: &str,
         surface: &str,
         angle_deg: f64,
-        spec: CaseSpec,
+        mut spec: CaseSpec,
     ) -> Result<Self> {
+        // One case is looked at: its last cycle's loop is sampled unless
+        // the config says otherwise (a sweep samples none by default).
+        if let (Some(h), Some(cfg)) = (spec.history.as_mut(), config.history.as_ref()) {
+            if cfg.loop_increments.is_none() {
+                h.sampling.increments = crate::config::SOLVE_LOOP_INCREMENTS;
+            }
+        }
         let ball = match &config.sweep.indenters {
             Some(names) => Some(names[0].as_str()),
             None => config.indenter.material.as_deref(),

@@ -1,5 +1,5 @@
 //! How `mpcontact solve` shows it is working: one live line on stderr with
-//! the elapsed time and the solver's phase (load increment k of n and the
+//! the elapsed time and the solver's phase (load-path segment k of n and the
 //! path's time left, coupling pass, normal or tangential iteration), on a
 //! terminal only and never with
 //! `--quiet`. Owns only stderr; reads the phase through the solver's tick
@@ -44,9 +44,9 @@ impl SolveProgress {
         bar.enable_steady_tick(REFRESH);
         let shown = bar.clone();
         let mut last: Option<Instant> = None;
-        // A load path's first increment seen and when: the rate since then
-        // gives the time left (a long wear run's thousands of increments
-        // cost about the same each).
+        // A load path's first segment seen and when: the rate since then
+        // gives the time left (a long wear run's hundreds of segments cost
+        // about the same each).
         let mut first: Option<(usize, Instant)> = None;
         let previous = solver::set_tick_hook(Some(Box::new(move || {
             if last.is_some_and(|t| t.elapsed() < REFRESH) {
@@ -54,7 +54,7 @@ impl SolveProgress {
             }
             last = Some(Instant::now());
             let phase = solver::phase();
-            let left = phase.increment.and_then(|(k, n)| {
+            let left = phase.segment.and_then(|(k, n)| {
                 let &mut (k0, t0) = first.get_or_insert((k, Instant::now()));
                 time_left(k0, t0.elapsed(), k, n)
             });
@@ -71,8 +71,8 @@ impl Drop for SolveProgress {
     }
 }
 
-/// The time a path has left at increment `k` of `n`, from the `elapsed`
-/// time since increment `k0` began: the increments done since then at
+/// The time a path has left at segment `k` of `n`, from the `elapsed`
+/// time since segment `k0` began: the segments done since then at
 /// their mean rate (`None` until one is done).
 pub fn time_left(k0: usize, elapsed: Duration, k: usize, n: usize) -> Option<Duration> {
     let done = k.checked_sub(k0).filter(|&d| d > 0)?;
@@ -80,13 +80,13 @@ pub fn time_left(k0: usize, elapsed: Duration, k: usize, n: usize) -> Option<Dur
 }
 
 /// The text of the line for `phase` (after the elapsed time and the case)
-/// with the path's time `left`, e.g. `increment 3/80 · about 1m05s left ·
+/// with the path's time `left`, e.g. `segment 3/80 · about 1m05s left ·
 /// pass 2 · tangential iteration 145` (the pass is the coupling loop's).
 /// Short enough for 80 columns after the case.
 pub fn describe(phase: &Phase, left: Option<Duration>) -> String {
     let mut parts = Vec::new();
-    if let Some((k, n)) = phase.increment {
-        parts.push(format!("increment {k}/{n}"));
+    if let Some((k, n)) = phase.segment {
+        parts.push(format!("segment {k}/{n}"));
     }
     if let Some(left) = left {
         let s = left.as_secs();
@@ -113,35 +113,35 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_line_names_increment_pass_and_iteration_in_that_order() {
+    fn the_line_names_segment_pass_and_iteration_in_that_order() {
         let phase = Phase {
-            increment: Some((3, 80)),
+            segment: Some((3, 80)),
             pass: Some(2),
             stage: Stage::Tangential,
             iterations: 145,
         };
         assert_eq!(
             describe(&phase, None),
-            "increment 3/80 · pass 2 · tangential iteration 145"
+            "segment 3/80 · pass 2 · tangential iteration 145"
         );
         assert_eq!(
             describe(&phase, Some(Duration::from_secs(65))),
-            "increment 3/80 · about 1m05s left · pass 2 · tangential iteration 145"
+            "segment 3/80 · about 1m05s left · pass 2 · tangential iteration 145"
         );
         assert_eq!(
             describe(&phase, Some(Duration::from_secs(3 * 3600 + 7 * 60))),
-            "increment 3/80 · about 3h07m left · pass 2 · tangential iteration 145"
+            "segment 3/80 · about 3h07m left · pass 2 · tangential iteration 145"
         );
     }
 
     #[test]
-    fn the_time_left_is_the_rate_so_far_over_the_increments_to_go() {
-        // Seen first at increment 1; at increment 11 of 100, 10 done in
+    fn the_time_left_is_the_rate_so_far_over_the_segments_to_go() {
+        // Seen first at segment 1; at segment 11 of 100, 10 done in
         // 20 s: 90 to go (11 included) at 2 s.
         let left = time_left(1, Duration::from_secs(20), 11, 100);
         assert_eq!(left, Some(Duration::from_secs(180)));
         assert_eq!(time_left(5, Duration::from_secs(3), 5, 100), None);
-        // At the last increment, what it takes at the rate so far.
+        // At the last segment, what it takes at the rate so far.
         assert_eq!(
             time_left(90, Duration::from_secs(20), 100, 100),
             Some(Duration::from_secs(2))

@@ -85,7 +85,10 @@ fn accepted_keys() -> BTreeSet<String> {
         tangential_ratios: Some(vec![0.0, 0.5]),
         tangential_um: Some(vec![0.0, 1.0]),
         normal_n: Some(vec![1.0, 2.0]),
-        steps_per_segment: 10,
+        steps_per_segment: coordinator::config::StepsCfg::Fixed(10),
+        tolerance: Some(1e-3),
+        save_every: Some(5),
+        loop_increments: Some(20),
         fretting: Some(coordinator::config::FrettingCfg {
             amplitude_ratio: Some(0.5),
             displacement_um: Some(1.0),

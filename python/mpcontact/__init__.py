@@ -77,7 +77,8 @@ class Result:
         the columns of the CLI's ``history.csv`` (``step``,
         ``normal_force_n``, ``fx_n``, ``fy_n``, ``delta_x_m``, ``delta_y_m``,
         ``delta_z_m``, ``contact_area_m2``, ``stick_area_m2``,
-        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``, and
+        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``,
+        ``segment_increments`` (the increments the row's segment took), and
         ``worn_volume_m3`` with a wear law, ``plastic_area_m2`` and
         ``plastic_penetration_max_m`` on a surface with a hardness). The per-cycle energy, reversal stiffness and residual shift are in
         ``scalars`` as in ``case.json``."""
@@ -103,6 +104,7 @@ class Result:
             "dissipated_j": col(lambda r: r["dissipated_j"]),
             "segment": col(lambda r: r["segment"], np.int64),
             "converged": col(lambda r: r["converged"], bool),
+            "segment_increments": col(lambda r: r.get("segment_increments", 0), np.int64),
         }
         # With a wear law, as the CLI's history.csv: the volume worn so far.
         if h.get("worn_volume_m3") is not None:
@@ -159,7 +161,7 @@ class Result:
 
     def wear_profiles(self):
         """The worn profiles through the contact's centre at the saved
-        cycles (``history.wear.save_every`` and the last), as the CLI's
+        cycles (``history.save_every`` and the last), as the CLI's
         ``wear_profiles.csv``: ``(position_m, {cycle: (along_x, along_y)})``
         with 1-D arrays, or ``None`` without a wear law."""
         h = self.scalars.get("history")

@@ -90,6 +90,15 @@ fn solve_history_case(
     let &(p_last, f_last) = points.last().expect("validated: at least one point");
     let mut last_spec = spec.clone();
     last_spec.load.normal_force_n = p_last;
+    // Under displacement control the last turning point is a shift; the
+    // force it left is the last row's.
+    let f_last = if history.displacement_controlled() {
+        let dir = solved.output.direction;
+        let f = solved.output.steps.last().map_or([0.0; 2], |r| r.force_n);
+        f[0] * dir[0] + f[1] * dir[1]
+    } else {
+        f_last
+    };
     last_spec.load.tangential_ratio = (f_last / (spec.load.friction * p_last)).max(0.0);
     let converged = solved.converged;
     let turning = solved.turning;
@@ -103,6 +112,12 @@ fn solve_history_case(
         Some(solved.output),
     )?;
     out.scalars.converged &= converged;
+    // μa (Eq. 19) reads a force-controlled partial slip: a path that
+    // imposes the shift has none (#59 item 10).
+    if history.displacement_controlled() {
+        out.scalars.mu_a = None;
+        out.scalars.mu_a_cells = None;
+    }
     out.turning = turning;
     out.fields.wear = solved.worn;
     out.fields.ball_wear = solved.ball_worn;

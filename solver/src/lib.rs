@@ -110,8 +110,9 @@ pub use model::radii::{
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
 pub use model::spec::{
-    CaseSpec, Load, LoadHistory, Numerics, TangentialMethod, Wear, WearLaw, MAX_GRID_POINTS,
-    MAX_HISTORY_STEPS, MAX_WEAR_JUMP,
+    CaseSpec, Increments, Load, LoadHistory, LoopSampling, Numerics, TangentialMethod, Wear,
+    WearLaw, AUTO_LOAD_STEP, AUTO_TOLERANCE, MAX_GRID_POINTS, MAX_HISTORY_STEPS, MAX_SHIFT_DOMAINS,
+    MAX_WEAR_COEFFICIENT, MAX_WEAR_JUMP, MIN_SHIFT_M,
 };
 pub use model::surface::{
     Island, LatticeKind, Sampling, Surface, Terrain, MIN_COVER, RESOLVED_CELLS_PER_PITCH,

@@ -155,7 +155,8 @@ fn a_fretting_history_meets_mindlin_deresiewicz() {
         s.history = Some(LoadHistory {
             tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
             normal_forces_n: None,
-            steps_per_segment: 20,
+            increments: solver::Increments::Fixed(20),
+            sampling: Default::default(),
             shifts_m: None,
             wear: None,
         });

@@ -94,7 +94,8 @@ fn fretting(amplitude: f64, cycles: usize, steps: usize) -> solver::CaseOutput {
     spec.history = Some(solver::LoadHistory {
         tangential_ratios: Vec::new(),
         normal_forces_n: None,
-        steps_per_segment: steps,
+        increments: solver::Increments::Fixed(steps),
+        sampling: Default::default(),
         shifts_m: Some(shifts),
         wear: None,
     });

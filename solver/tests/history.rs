@@ -4,62 +4,12 @@
 //! crystal's 120° period of the energy per cycle.
 mod common;
 
+use common::md::Md;
 use common::table_1a_fe;
 use solver::{solve_case, CaseSpec, HistoryOutput, KernelCache, LoadHistory};
 
 const P: f64 = 20.0;
 const MU: f64 = 0.28571;
-
-/// Mindlin–Deresiewicz closed forms for Table 1a (Hertz radius a).
-struct Md {
-    /// Hertz radius, m.
-    a: f64,
-    /// δ* = 3μPK/(16a), m.
-    delta_star: f64,
-    /// K = (2 − ν)/G, 1/Pa.
-    k: f64,
-}
-
-impl Md {
-    fn new() -> Md {
-        let (e, nu, r) = (210.0e9_f64, 0.3_f64, 18.0e-3_f64);
-        let a = (3.0 * P * r / (4.0 * e / (1.0 - nu * nu))).cbrt();
-        let g = e / (2.0 * (1.0 + nu));
-        let k = (2.0 - nu) / g;
-        Md {
-            a,
-            delta_star: 3.0 * MU * P * k / (16.0 * a),
-            k,
-        }
-    }
-
-    /// First loading 0 → Q.
-    fn first(&self, q: f64) -> f64 {
-        self.delta_star * (1.0 - (1.0 - q / (MU * P)).powf(2.0 / 3.0))
-    }
-
-    /// Unloading from Q* to Q.
-    fn unload(&self, q_star: f64, q: f64) -> f64 {
-        let mp = MU * P;
-        self.delta_star
-            * (2.0 * (1.0 - (q_star - q) / (2.0 * mp)).powf(2.0 / 3.0)
-                - (1.0 - q_star / mp).powf(2.0 / 3.0)
-                - 1.0)
-    }
-
-    /// Reloading from −Q* to Q.
-    fn reload(&self, q_star: f64, q: f64) -> f64 {
-        -self.unload(q_star, -q)
-    }
-
-    /// Energy per full cycle of amplitude Q*.
-    fn energy(&self, q_star: f64) -> f64 {
-        let mp = MU * P;
-        let x = q_star / mp;
-        9.0 * mp * mp * self.k / (10.0 * self.a)
-            * (1.0 - (1.0 - x).powf(5.0 / 3.0) - 5.0 * x / 6.0 * (1.0 + (1.0 - x).powf(2.0 / 3.0)))
-    }
-}
 
 fn fretting(n: usize, spacing_um: f64, amplitude: f64, cycles: usize, steps: usize) -> CaseSpec {
     let mut ratios = vec![0.0, amplitude];
@@ -70,7 +20,8 @@ fn fretting(n: usize, spacing_um: f64, amplitude: f64, cycles: usize, steps: usi
         history: Some(LoadHistory {
             tangential_ratios: ratios,
             normal_forces_n: None,
-            steps_per_segment: steps,
+            increments: solver::Increments::Fixed(steps),
+            sampling: Default::default(),
             shifts_m: None,
             wear: None,
         }),
@@ -149,10 +100,13 @@ fn mindlin_deresiewicz_fretting_loops_at_0_6_and_0_9_mu_p() {
             (e / e_cf - 1.0).abs() < 0.02,
             "A = {amplitude}: ΔW {e:e} vs {e_cf:e}"
         );
-        // Equal but for the elastic energy between the cycle's end and start
-        // states, which differ by the same non-Masing part (1.7e-6 at A = 0.6).
+        // The dissipation (the end tractions' work, exact at any increment
+        // size on these monotone segments) against the loop's area by the
+        // trapezoid over its 20 points a branch, which errs by about 1/n² on
+        // the concave branches: 2.6e-3 at A = 0.6 (before round 5 both were
+        // trapezoids and agreed to 1e-5, and both were 0.7 % low).
         assert!(
-            (e / area - 1.0).abs() < 1e-5,
+            (e / area - 1.0).abs() < 2.0 / (steps * steps) as f64,
             "Σ q·Δs {e:e} vs ∮F dδ {area:e}"
         );
         // Stiffness of the first increment after the last reversal (+Q* → −Q*
@@ -201,7 +155,8 @@ fn proportional_loading_below_mu_leaves_no_slip() {
     spec.history = Some(LoadHistory {
         tangential_ratios: vec![ratio, ratio],
         normal_forces_n: Some(vec![P / 8.0, P]),
-        steps_per_segment: 20,
+        increments: solver::Increments::Fixed(20),
+        sampling: Default::default(),
         shifts_m: None,
         wear: None,
     });
@@ -269,7 +224,8 @@ fn quick_fretting(material: &str, surface: &str, angle_deg: f64) -> CaseSpec {
         history: Some(LoadHistory {
             tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
             normal_forces_n: None,
-            steps_per_segment: 10,
+            increments: solver::Increments::Fixed(10),
+            sampling: Default::default(),
             shifts_m: None,
             wear: None,
         }),
@@ -299,8 +255,10 @@ fn anisotropic_and_patterned_fretting_conserve_force_and_keep_the_120_degree_per
             h.dissipated_energy_per_cycle_j.unwrap(),
             h.loop_area_per_cycle_j.unwrap(),
         );
+        // The loop's trapezoid over 10 points a branch errs by about
+        // 1/n² (1.05e-2 here).
         assert!(
-            e > 0.0 && (e / area - 1.0).abs() < 1e-3,
+            e > 0.0 && (e / area - 1.0).abs() < 2e-2,
             "{e:e} vs {area:e}"
         );
         energy.push(e);

@@ -434,7 +434,8 @@ fn unloading_keeps_the_dent_and_reloading_does_not_yield_again() {
     path.history = Some(LoadHistory {
         tangential_ratios: vec![0.0, 0.0, 0.0],
         normal_forces_n: Some(vec![LOAD_1A, 0.1 * LOAD_1A, LOAD_1A]),
-        steps_per_segment: 2,
+        increments: solver::Increments::Fixed(2),
+        sampling: Default::default(),
         shifts_m: None,
         wear: None,
     });
@@ -489,7 +490,8 @@ fn a_shear_limit_caps_the_sliding_force_at_the_integral_of_min_mu_p_tau() {
     spec.history = Some(LoadHistory {
         tangential_ratios: Vec::new(),
         normal_forces_n: None,
-        steps_per_segment: 4,
+        increments: solver::Increments::Fixed(4),
+        sampling: Default::default(),
         shifts_m: Some(vec![0.0, 3.0 * delta_star]),
         wear: None,
     });
@@ -530,7 +532,8 @@ fn a_fretting_path_on_a_capped_sphere_reports_its_plastic_area_and_a_dent_that_n
     spec.history = Some(LoadHistory {
         tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
         normal_forces_n: Some(vec![LOAD_1A, LOAD_1A, 0.5 * LOAD_1A, LOAD_1A]),
-        steps_per_segment: 3,
+        increments: solver::Increments::Fixed(3),
+        sampling: Default::default(),
         shifts_m: None,
         wear: None,
     });

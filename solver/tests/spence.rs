@@ -442,7 +442,8 @@ fn solver_history(
     spec.history = Some(LoadHistory {
         tangential_ratios: vec![0.0, 0.0],
         normal_forces_n: Some(vec![first, last]),
-        steps_per_segment: steps,
+        increments: solver::Increments::Fixed(steps),
+        sampling: Default::default(),
         shifts_m: None,
         wear: None,
     });

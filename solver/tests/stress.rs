@@ -513,7 +513,8 @@ fn a_load_history_keeps_the_tractions_of_its_turning_points() {
         history: Some(solver::LoadHistory {
             tangential_ratios: vec![0.0, 0.5, -0.5],
             normal_forces_n: None,
-            steps_per_segment: 3,
+            increments: solver::Increments::Fixed(3),
+            sampling: Default::default(),
             shifts_m: None,
             wear: None,
         }),

@@ -108,7 +108,8 @@ fn uncoupled_and_coupled_load_histories_are_bit_identical_on_1_2_and_3_threads()
             history: Some(LoadHistory {
                 tangential_ratios: vec![0.0, 0.6, -0.6],
                 normal_forces_n: None,
-                steps_per_segment: steps,
+                increments: solver::Increments::Fixed(steps),
+                sampling: Default::default(),
                 shifts_m: None,
                 wear: None,
             }),
@@ -136,7 +137,8 @@ fn the_active_set_iteration_is_bit_identical_on_1_2_and_3_threads() {
             spec.history = Some(LoadHistory {
                 tangential_ratios: vec![0.0, 0.6, -0.6],
                 normal_forces_n: None,
-                steps_per_segment: 4,
+                increments: solver::Increments::Fixed(4),
+                sampling: Default::default(),
                 shifts_m: None,
                 wear: None,
             });

@@ -27,7 +27,8 @@ fn worn(law: WearLaw, shifts: Vec<f64>, steps: usize) -> solver::CaseOutput {
     spec.history = Some(LoadHistory {
         tangential_ratios: Vec::new(),
         normal_forces_n: None,
-        steps_per_segment: steps,
+        increments: solver::Increments::Fixed(steps),
+        sampling: Default::default(),
         shifts_m: Some(shifts),
         wear: Some(Wear::new(law)),
     });
@@ -114,13 +115,13 @@ fn fretted(k: f64, cycles: usize, jump: f64) -> solver::CaseOutput {
     spec.history = Some(LoadHistory {
         tangential_ratios: ratios,
         normal_forces_n: None,
-        steps_per_segment: 10,
+        increments: solver::Increments::Fixed(10),
+        sampling: Default::default(),
         shifts_m: None,
         wear: Some(Wear {
             law: WearLaw::Archard { k },
             ball: None,
             jump,
-            save_every: 0,
         }),
     });
     solve_case(&spec, &mut KernelCache::new()).expect("the path solves")
@@ -305,13 +306,13 @@ fn islands_worn_through_are_counted() {
         spec.history = Some(LoadHistory {
             tangential_ratios: vec![0.0, 0.6, -0.6, 0.6],
             normal_forces_n: None,
-            steps_per_segment: 5,
+            increments: solver::Increments::Fixed(5),
+            sampling: Default::default(),
             shifts_m: None,
             wear: Some(Wear {
                 law: WearLaw::Archard { k: 1e-5 * 1e-9 },
                 ball: None,
                 jump: 2e6,
-                save_every: 0,
             }),
         });
         let out = solve_case(&spec, &mut KernelCache::new()).expect("the path solves");
@@ -342,13 +343,13 @@ fn both_wear(
     spec.history = Some(LoadHistory {
         tangential_ratios: Vec::new(),
         normal_forces_n: None,
-        steps_per_segment: 10,
+        increments: solver::Increments::Fixed(10),
+        sampling: Default::default(),
         shifts_m: Some(shifts),
         wear: Some(Wear {
             law: WearLaw::Archard { k },
             ball: Some(WearLaw::Archard { k: k_ball }),
             jump: 1.0,
-            save_every: 0,
         }),
     });
     solve_case(&spec, &mut KernelCache::new()).expect("the path solves")

@@ -4,7 +4,7 @@
 use super::Config;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
-use solver::{LoadHistory, Wear, WearLaw};
+use solver::{Increments, LoadHistory, Wear, WearLaw};
 
 /// `[history]`: a load path applied to every case (fretting loops,
 /// proportional loading), PHYSICS.md §5b. Either the turning points
@@ -23,9 +23,22 @@ pub struct HistoryCfg {
     /// Normal load at each turning point, N (default: `load.normal_n` throughout).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub normal_n: Option<Vec<f64>>,
-    /// Increments per segment between turning points.
-    #[serde(default = "default_steps")]
-    pub steps_per_segment: usize,
+    /// Increments per segment between turning points: `"auto"` (chosen by
+    /// the path's error estimate) or a number.
+    #[serde(default)]
+    pub steps_per_segment: StepsCfg,
+    /// The error of the energy per cycle auto increments aim at.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// The full cycles someone looks at: every this many and the last
+    /// (0: the last only); their loops are sampled at `loop_increments`
+    /// and a wear law keeps its worn profiles at them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub save_every: Option<usize>,
+    /// Increments per segment of the cycles looked at (0: no sampled
+    /// loops). Default: [`SOLVE_LOOP_INCREMENTS`] in `solve`, 0 in sweeps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loop_increments: Option<usize>,
     /// Shorthand: 0 → +A → −A → +A … with `cycles` full cycles.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fretting: Option<FrettingCfg>,
@@ -84,6 +97,9 @@ impl WearCfg {
         let coefficient = |key: &str, v: f64| -> Result<f64> {
             if !(v.is_finite() && v >= 0.0) {
                 bail!("history.wear.{key} = {v}: must be finite and ≥ 0");
+            }
+            if v * 1e-9 > solver::MAX_WEAR_COEFFICIENT {
+                bail!("history.wear.{key} = {v}: above 0.1, more than any measured wear (fretting: 1e-6 to 1e-4; severe adhesive wear of metals about 1e-2); at that rate a contact wears through its own approach in a few slips");
             }
             Ok(v * 1e-9)
         };
@@ -150,9 +166,35 @@ fn one_cycle() -> usize {
     1
 }
 
-fn default_steps() -> usize {
-    20
+/// `history.steps_per_segment`: `"auto"` or a number of increments.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum StepsCfg {
+    /// A fixed number of increments per segment.
+    Fixed(usize),
+    /// `"auto"` (checked to be that word).
+    Named(AutoWord),
 }
+
+impl Default for StepsCfg {
+    fn default() -> Self {
+        StepsCfg::Named(AutoWord::Auto)
+    }
+}
+
+/// The one word `history.steps_per_segment` takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AutoWord {
+    /// Increments chosen by the path's error estimate.
+    Auto,
+}
+
+/// The increments per segment of the cycles looked at in `mpcontact
+/// solve` (and Python's `solve`) when `history.loop_increments` is not
+/// given: the loop drawn with 20 points a branch, as the fixed default of
+/// before drew every cycle.
+pub const SOLVE_LOOP_INCREMENTS: usize = 20;
 
 /// Most fretting cycles a config may ask for (each is two segments).
 pub const MAX_CYCLES: usize = 1000;
@@ -168,6 +210,11 @@ impl HistoryCfg {
     /// of `fretting = { cycles = N }`; `None` outside a map.
     pub fn load_history_at(&self, amplitude_um: Option<f64>) -> Result<LoadHistory> {
         let mut path = self.path_at(amplitude_um)?;
+        path.increments = self.increments()?;
+        path.sampling = solver::LoopSampling {
+            every: self.save_every()?,
+            increments: self.loop_increments.unwrap_or(0),
+        };
         path.wear = match &self.wear {
             Some(w) => Some({
                 let (law, ball) = w.laws()?;
@@ -175,12 +222,39 @@ impl HistoryCfg {
                     law,
                     ball,
                     jump: self.wear_jump(w)?,
-                    save_every: w.save_every.unwrap_or(0),
                 }
             }),
             None => None,
         };
         Ok(path)
+    }
+
+    /// The solver's increments of `steps_per_segment` and `tolerance`.
+    fn increments(&self) -> Result<Increments> {
+        match self.steps_per_segment {
+            StepsCfg::Fixed(k) => {
+                if let Some(t) = self.tolerance {
+                    bail!("history.tolerance = {t}: belongs to steps_per_segment = \"auto\" (here {k} increments per segment are fixed); leave one of them out");
+                }
+                Ok(Increments::Fixed(k))
+            }
+            StepsCfg::Named(AutoWord::Auto) => {
+                let tolerance = self.tolerance.unwrap_or(solver::AUTO_TOLERANCE);
+                if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 0.1) {
+                    bail!("history.tolerance = {tolerance}: must be above 0 and below 0.1 (the relative error of the energy per cycle the increments aim at; default {:e})", solver::AUTO_TOLERANCE);
+                }
+                Ok(Increments::Auto { tolerance })
+            }
+        }
+    }
+
+    /// `history.save_every`, or its older place `history.wear.save_every`.
+    fn save_every(&self) -> Result<usize> {
+        let old = self.wear.as_ref().and_then(|w| w.save_every);
+        match (self.save_every, old) {
+            (Some(a), Some(b)) if a != b => bail!("history.save_every = {a} and history.wear.save_every = {b} name the cycles looked at twice: give history.save_every only (it keeps the worn profiles too)"),
+            (a, b) => Ok(a.or(b).unwrap_or(0)),
+        }
     }
 
     /// The cycle jump of `history.wear.physical_cycles`: the physical
@@ -234,7 +308,8 @@ impl HistoryCfg {
             return Ok(LoadHistory {
                 tangential_ratios: Vec::new(),
                 normal_forces_n: None,
-                steps_per_segment: self.steps_per_segment,
+                increments: Increments::Fixed(1),
+                sampling: Default::default(),
                 shifts_m: Some(shifts),
                 wear: None,
             });
@@ -243,7 +318,8 @@ impl HistoryCfg {
             return Ok(LoadHistory {
                 tangential_ratios: Vec::new(),
                 normal_forces_n: self.normal_n.clone(),
-                steps_per_segment: self.steps_per_segment,
+                increments: Increments::Fixed(1),
+                sampling: Default::default(),
                 shifts_m: Some(d.iter().map(|v| v * 1e-6).collect()),
                 wear: None,
             });
@@ -260,7 +336,8 @@ impl HistoryCfg {
                 return Ok(LoadHistory {
                     tangential_ratios: Vec::new(),
                     normal_forces_n: None,
-                    steps_per_segment: self.steps_per_segment,
+                    increments: Increments::Fixed(1),
+                    sampling: Default::default(),
                     shifts_m: Some(shifts),
                     wear: None,
                 });
@@ -284,7 +361,8 @@ impl HistoryCfg {
         Ok(LoadHistory {
             tangential_ratios: ratios,
             normal_forces_n: self.normal_n.clone(),
-            steps_per_segment: self.steps_per_segment,
+            increments: Increments::Fixed(1),
+            sampling: Default::default(),
             shifts_m: None,
             wear: None,
         })
@@ -392,7 +470,15 @@ mod tests {
         .unwrap();
         let h = c.load_history().unwrap();
         assert_eq!(h.tangential_ratios, vec![0.0, 0.5, -0.5, 0.5, -0.5, 0.5]);
-        assert_eq!(h.steps_per_segment, 20);
+        // Auto increments by default, no sampled loop (a sweep's default;
+        // `solve` samples the last cycle's, see `solve::CaseChoice`).
+        assert_eq!(
+            h.increments,
+            solver::Increments::Auto {
+                tolerance: solver::AUTO_TOLERANCE
+            }
+        );
+        assert_eq!(h.sampling, solver::LoopSampling::default());
         let (_, spec) = &c.cases().unwrap()[0];
         assert_eq!(spec.history.as_ref(), Some(&h));
         assert_eq!(spec.load.tangential_ratio, 0.5, "the path's last ratio");
@@ -443,9 +529,11 @@ mod tests {
             &[],
         )
         .unwrap();
-        let w = c.load_history().unwrap().wear.unwrap();
+        let h = c.load_history().unwrap();
+        let w = h.wear.unwrap();
         assert_eq!(w.jump, 2500.0);
-        assert_eq!(w.save_every, 2);
+        // The older place of history.save_every.
+        assert_eq!(h.sampling.every, 2);
         assert_eq!(w.law, solver::WearLaw::Energy { alpha: 2e-5 * 1e-9 });
         // The ball wears by the same law with its own coefficient.
         let c = Config::parse(

@@ -23,7 +23,10 @@ mod toml_text;
 
 pub use convergence::{ladder_points, ConvergenceCfg, MAX_LEVELS};
 pub use grid::{GridCfg, IndenterCfg, LoadCfg};
-pub use history::{FrettingCfg, HistoryCfg, WearCfg, WearLawCfg, MAX_CYCLES};
+pub use history::{
+    AutoWord, FrettingCfg, HistoryCfg, StepsCfg, WearCfg, WearLawCfg, MAX_CYCLES,
+    SOLVE_LOOP_INCREMENTS,
+};
 pub use materials::{CubicCfg, IsoCfg, MaterialCfg, SweepMaterial};
 pub use orientations::{Orientation, OrientationsCfg};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};

@@ -13,7 +13,7 @@ use std::path::Path;
 use super::plot::{self, err, Area, Figure, Frame, PALETTE};
 
 /// Header of `history.csv`.
-pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged";
+pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged,segment_increments";
 
 /// The column `history.csv` gains on a path with a wear law: the volume
 /// worn from the start of the path to the increment (a path without one
@@ -42,7 +42,7 @@ pub fn history_csv(h: &HistoryOutput) -> String {
     for r in &h.steps {
         let _ = write!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.step,
             fmt_f64(r.normal_force_n),
             fmt_f64(r.force_n[0]),
@@ -56,6 +56,7 @@ pub fn history_csv(h: &HistoryOutput) -> String {
             fmt_f64(r.dissipated_j),
             r.segment,
             r.converged,
+            r.segment_increments,
         );
         if wear {
             let _ = write!(out, ",{}", fmt_f64(r.worn_volume_m3));
@@ -86,15 +87,25 @@ fn loop_lines(h: &HistoryOutput) -> Vec<(String, Vec<(f64, f64)>)> {
     if t.len() < 2 {
         return lines;
     }
-    lines.push((
-        "first loading".to_string(),
-        (t[0]..=t[1]).map(point).collect(),
-    ));
+    // Only the loops sampled at a fixed resolution: the others are a few
+    // points each (auto increments), which a line would draw as a polygon.
+    let sampled = |seg: usize| h.sampled_segments.contains(&seg);
+    if sampled(0) {
+        lines.push((
+            "first loading".to_string(),
+            (t[0]..=t[1]).map(point).collect(),
+        ));
+    }
     let mut j = 1;
     let mut cycle = 1;
     while j < t.len() - 1 {
-        let end = t[(j + 2).min(t.len() - 1)];
-        lines.push((format!("cycle {cycle}"), (t[j]..=end).map(point).collect()));
+        let end = (j + 2).min(t.len() - 1);
+        if (j..end).all(sampled) {
+            lines.push((
+                format!("cycle {cycle}"),
+                (t[j]..=t[end]).map(point).collect(),
+            ));
+        }
         j += 2;
         cycle += 1;
     }
@@ -186,9 +197,23 @@ pub fn write_history(
     warnings.extend(
         super::wear::wear_warnings(h)
             .into_iter()
+            .chain(history_warnings(h))
             .map(|w| format!("{title}: {w}")),
     );
     Ok(warnings)
+}
+
+/// The warnings of a path: auto increments that could not meet their
+/// tolerance.
+pub fn history_warnings(h: &HistoryOutput) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if h.auto_tolerance_met == Some(false) {
+        warnings.push(format!(
+            "some increments reached the smallest auto increment (1/4096 of a segment) or the path's {} increments above history.tolerance (auto_tolerance_met = false in case.json): the path changes faster than the tolerance allows; loosen history.tolerance or split the path (more simulated cycles with a wear law)",
+            solver::MAX_HISTORY_STEPS
+        ));
+    }
+    warnings
 }
 
 #[cfg(test)]
@@ -211,6 +236,7 @@ mod tests {
             direction: [1.0, 0.0],
             steps,
             turning_steps: vec![0, 2, 4, 6],
+            sampled_segments: vec![0, 1, 2],
             ..Default::default()
         }
     }
@@ -240,7 +266,7 @@ mod tests {
             lines[0],
             format!("{HISTORY_HEADER},{HISTORY_PLASTIC_COLUMNS}")
         );
-        assert!(lines[3].ends_with(",true,2e-9,2e-7"), "{}", lines[3]);
+        assert!(lines[3].ends_with(",true,0,2e-9,2e-7"), "{}", lines[3]);
     }
 
     #[test]
@@ -252,5 +278,9 @@ mod tests {
         assert_eq!(lines[1].1.first(), Some(&(3.0, 2.0)));
         assert_eq!(lines[1].1.last(), Some(&(3.0, 2.0)));
         assert_eq!(lines[1].1.len(), 5);
+        // A cycle of auto increments is not drawn (a few points are no loop).
+        let mut auto = history();
+        auto.sampled_segments = vec![0];
+        assert_eq!(loop_lines(&auto).len(), 1);
     }
 }

@@ -194,12 +194,25 @@ pub fn write_wear(dir: &Path, h: &HistoryOutput, grid: &Grid, title: &str) -> Re
 /// [`solver::WEAR_JUMP_LIMIT`]), islands worn through.
 pub fn wear_warnings(h: &HistoryOutput) -> Vec<String> {
     let mut warnings = Vec::new();
+    // Without a jump every cycle is simulated: a cycle that wears that much
+    // is the wear coefficient's doing, not the jump's (#59 item 2).
+    let jumped = h
+        .wear_cycles
+        .first()
+        .is_some_and(|c| c.physical_cycles != c.cycle as f64);
     if let Some(ratio) = h.wear_jump_ratio.filter(|&r| r > solver::WEAR_JUMP_LIMIT) {
-        warnings.push(format!(
-            "a simulated cycle wore up to {:.1} % of the approach (above {} %): the cycle jump (history.wear.physical_cycles / history.fretting.cycles) may be too coarse for the worn profile's transient; simulate more cycles and compare",
-            100.0 * ratio,
-            100.0 * solver::WEAR_JUMP_LIMIT
-        ));
+        warnings.push(if jumped {
+            format!(
+                "a simulated cycle wore up to {:.1} % of the approach (above {} %): the cycle jump (history.wear.physical_cycles / history.fretting.cycles) may be too coarse for the worn profile's transient; simulate more cycles and compare",
+                100.0 * ratio,
+                100.0 * solver::WEAR_JUMP_LIMIT
+            )
+        } else {
+            format!(
+                "one cycle wore up to {:.1} % of the approach, with no cycle jump: the wear coefficient (history.wear.k_mm3_per_nm or alpha_mm3_per_j) makes the contact conform within a few cycles, a worn contact whose pressure is far from Hertz's",
+                100.0 * ratio
+            )
+        });
     }
     if let Some(c) = h.wear_cycles.iter().find(|c| c.worn_through_cells > 0) {
         warnings.push(format!(
@@ -254,6 +267,19 @@ mod tests {
         assert_eq!(rows[2], "0,2e-8,1e-8");
         let warnings = wear_warnings(&h);
         assert!(warnings.len() == 1 && warnings[0].contains("5.0 %"));
+        assert!(warnings[0].contains("cycle jump"));
+        // Without a jump the coefficient is named, not the jump.
+        let mut unjumped = h.clone();
+        for c in &mut unjumped.wear_cycles {
+            c.physical_cycles = c.cycle as f64;
+        }
+        let warnings = wear_warnings(&unjumped);
+        assert!(
+            warnings.len() == 1
+                && warnings[0].contains("no cycle jump")
+                && warnings[0].contains("k_mm3_per_nm"),
+            "{warnings:?}"
+        );
         assert!(wear_warnings(&HistoryOutput::default()).is_empty());
         let mut through = h.clone();
         through.wear_jump_ratio = Some(0.01);

@@ -34,9 +34,10 @@ pub enum Stage {
 /// tick hook (through [`phase`]) to show progress. Reset when a case starts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Phase {
-    /// The increment of a load history being solved (1-based) and how many
-    /// the path has; `None` for a case without a history.
-    pub increment: Option<(usize, usize)>,
+    /// The segment of a load history being solved (1-based) and how many
+    /// the path has (a segment's increments are chosen as it goes); `None`
+    /// for a case without a history.
+    pub segment: Option<(usize, usize)>,
     /// The coupling loop's pass (1-based) in the current step; `None` before
     /// it starts and when coupling is off (one uncoupled pass is no loop).
     pub pass: Option<usize>,
@@ -51,7 +52,7 @@ thread_local! {
     static CANCELLED: Cell<bool> = const { Cell::new(false) };
     static PHASE: Cell<Phase> = const {
         Cell::new(Phase {
-            increment: None,
+            segment: None,
             pass: None,
             stage: Stage::Starting,
             iterations: 0,
@@ -104,10 +105,10 @@ pub(crate) fn stage(stage: Stage) {
     });
 }
 
-/// Increment `k` of `of` of a load history starts: a tick that may stop early.
-pub(crate) fn increment(k: usize, of: usize) -> Result<(), SolverError> {
+/// Segment `k` of `of` of a load history starts: a tick that may stop early.
+pub(crate) fn segment(k: usize, of: usize) -> Result<(), SolverError> {
     update(|ph| {
-        ph.increment = Some((k, of));
+        ph.segment = Some((k, of));
         ph.pass = None;
     });
     tick();
@@ -251,14 +252,15 @@ mod tests {
     }
 
     #[test]
-    fn a_history_reports_each_increment_in_order_with_its_passes_and_iterations() {
+    fn a_history_reports_each_segment_in_order_with_its_passes_and_iterations() {
         // Fretting, half a cycle out and back (0 → 0.6 → −0.6 of μP), 2
-        // increments per segment: 4 increments, coupled.
+        // increments per segment: 2 segments, coupled.
         let spec = crate::CaseSpec {
             history: Some(crate::LoadHistory {
                 tangential_ratios: vec![0.6, -0.6],
                 normal_forces_n: None,
-                steps_per_segment: 2,
+                increments: crate::Increments::Fixed(2),
+                sampling: Default::default(),
                 shifts_m: None,
                 wear: None,
             }),
@@ -266,22 +268,20 @@ mod tests {
         };
         let (seen, scalars) = phases_of(&spec);
         assert_eq!(seen[0].stage, Stage::Kernel);
-        assert_eq!(seen[0].increment, None);
-        // The increments as the hook saw them: 1..=4 of 4, in order, none skipped.
-        let mut increments: Vec<(usize, usize)> = seen.iter().filter_map(|p| p.increment).collect();
-        increments.dedup();
-        assert_eq!(increments, vec![(1, 4), (2, 4), (3, 4), (4, 4)]);
-        // Coupled: every increment runs pass 1 of the coupling loop, and
-        // the passes counted add up to the case's coupling iterations.
-        for k in 1..=4 {
+        assert_eq!(seen[0].segment, None);
+        // The segments as the hook saw them: 1..=2 of 2, in order, none skipped.
+        let mut segments: Vec<(usize, usize)> = seen.iter().filter_map(|p| p.segment).collect();
+        segments.dedup();
+        assert_eq!(segments, vec![(1, 2), (2, 2)]);
+        // Coupled: every segment runs pass 1 of the coupling loop, and
+        // the passes counted add up to the case's coupling iterations
+        // (each increment's passes count up from 1).
+        for k in 1..=2 {
             assert!(seen
                 .iter()
-                .any(|p| p.increment == Some((k, 4)) && p.pass == Some(1)));
+                .any(|p| p.segment == Some((k, 2)) && p.pass == Some(1)));
         }
-        let mut passes: Vec<(usize, usize)> = seen
-            .iter()
-            .filter_map(|p| Some((p.increment?.0, p.pass?)))
-            .collect();
+        let mut passes: Vec<usize> = seen.iter().filter_map(|p| p.pass).collect();
         passes.dedup();
         assert_eq!(passes.len(), scalars.coupling_iterations);
         // Iterations count up within a stage: a normal and a tangential
@@ -292,13 +292,11 @@ mod tests {
     }
 
     #[test]
-    fn an_uncoupled_single_step_reports_no_pass_and_no_increment() {
+    fn an_uncoupled_single_step_reports_no_pass_and_no_segment() {
         let mut spec = small_case();
         spec.numerics.coupling = false;
         let (seen, scalars) = phases_of(&spec);
-        assert!(seen
-            .iter()
-            .all(|p| p.pass.is_none() && p.increment.is_none()));
+        assert!(seen.iter().all(|p| p.pass.is_none() && p.segment.is_none()));
         // The most iterations seen in the tangential stage are the solve's
         // (a tick comes at the start of each; 32² has no coarse levels,
         // whose iterations would count too).

@@ -110,15 +110,82 @@ impl Default for Numerics {
 
 /// Most increments a load history may ask for (all segments together): a
 /// bound against a typo (`steps_per_segment = 1e6`), far above the few
-/// hundred a fretting study needs.
+/// hundred a fretting study needs. Auto increments stop subdividing there
+/// too.
 pub const MAX_HISTORY_STEPS: usize = 100_000;
 
+/// How the segments of a load path are split into increments.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Increments {
+    /// As few increments per segment as the path's error estimate accepts
+    /// at `tolerance` (see `solve::history`): one where the end state does
+    /// not depend on the path (a monotone segment at constant pressure),
+    /// more where it does (coupling moving the contact's edge, a changing
+    /// normal load, a cap that flows, wear).
+    Auto {
+        /// The relative error of the energy per cycle the increments aim
+        /// at, and (×[`AUTO_LOAD_STEP`]) the largest relative change of the
+        /// normal problem's data (the load, the worn depth against the
+        /// approach) over one increment.
+        tolerance: f64,
+    },
+    /// This many increments in every segment.
+    Fixed(usize),
+}
+
+/// With [`Increments::Auto`] and a wear law, the largest depth one
+/// increment may wear (its cycle jump included) is this many times the
+/// tolerance, of the approach: 1e-4 of it at the default. The wear of a
+/// jump is taken at the pressure it leaves, an implicit step whose error is
+/// first order in it: Table 1(a) Fe at 128², k = 1e-5, 10⁴ cycles as 10
+/// simulated (2.2e-4 of the approach a segment) wore 1.6e-3 less in one
+/// increment a segment than in 20; as 100 simulated, 3.6e-4 more (the slip
+/// directions' part).
+pub const AUTO_WEAR_STEP: f64 = 0.1;
+
+/// With [`Increments::Auto`] and coupling, the increments a segment that
+/// moves the tangential load is expected to take (what `check` prices).
+pub const AUTO_COUPLED_INCREMENTS: usize = 8;
+
+/// Default tolerance of [`Increments::Auto`]: the energy per cycle within
+/// 1e-3 of its converged value.
+pub const AUTO_TOLERANCE: f64 = 1e-3;
+
+/// With [`Increments::Auto`], the largest relative change of the normal
+/// load (and of the worn depth against the approach) over one increment is
+/// this many times the tolerance: 2.5 % at the default. Spence's normal
+/// loading with friction (Table 1(a) Fe, μ = 0.3, coupled, 0.5 → 20 N)
+/// reads its stick radius 0.45 % low when its last increments change P by
+/// 2.4 % and 1.5 % low at 9.8 % (its error follows ΔP/P, ×0.19).
+pub const AUTO_LOAD_STEP: f64 = 25.0;
+
+impl Default for Increments {
+    fn default() -> Self {
+        Increments::Auto {
+            tolerance: AUTO_TOLERANCE,
+        }
+    }
+}
+
+/// The cycles of a path someone looks at, and how finely their loops are
+/// sampled.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LoopSampling {
+    /// The full cycles looked at: every this many simulated cycles and the
+    /// last; 0: the last only. A wear law keeps its worn profiles at them.
+    pub every: usize,
+    /// Increments per segment on those cycles, whose force–shift loops
+    /// (and history rows) are sampled at this resolution; 0: none (every
+    /// segment in the path's own increments).
+    pub increments: usize,
+}
+
 /// A load path: turning points of the normal load and of the tangential
-/// force, joined by straight lines, each segment split into
-/// `steps_per_segment` increments (a fretting loop, a proportional
-/// loading). The state before the path is frictionless normal contact under
-/// the first turning point's normal load; if the first tangential ratio is
-/// not zero, the path starts with a segment from zero force to it.
+/// force, joined by straight lines, each segment split into increments
+/// (a fretting loop, a proportional loading). The state before the path
+/// is frictionless normal contact under the first turning point's normal
+/// load; if the first tangential ratio is not zero, the path starts with a
+/// segment from zero force to it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LoadHistory {
     /// Turning points of F/(μP) along the case's force direction (signed:
@@ -127,8 +194,11 @@ pub struct LoadHistory {
     /// Turning points of the normal load, N, one per tangential ratio;
     /// `None`: constant, the case's `load.normal_force_n`.
     pub normal_forces_n: Option<Vec<f64>>,
-    /// Increments per segment between turning points.
-    pub steps_per_segment: usize,
+    /// How the segments between turning points are split.
+    pub increments: Increments,
+    /// The cycles looked at and their loops' resolution.
+    #[serde(default)]
+    pub sampling: LoopSampling,
     /// Displacement control (as fretting rigs run): the turning points of
     /// the ball's rigid tangential shift along the force direction, m
     /// (signed), measured from the end of the frictionless normal loading
@@ -156,14 +226,11 @@ pub struct Wear {
     #[serde(default)]
     pub ball: Option<WearLaw>,
     /// Cycle jumping: the physical cycles each simulated one stands for
-    /// (each increment's wear is applied this many times, implicitly in
-    /// the pressure; see `solve_history`), ≥ 1; 1: no jump.
+    /// (each increment's wear of the cycles is applied this many times,
+    /// implicitly in the pressure; the first loading's once; see
+    /// `solve_history`), ≥ 1; 1: no jump.
     #[serde(default = "no_jump")]
     pub jump: f64,
-    /// The worn profiles through the contact's centre are kept every this
-    /// many simulated full cycles, and at the last; 0: at the last only.
-    #[serde(default)]
-    pub save_every: usize,
 }
 
 fn no_jump() -> f64 {
@@ -182,7 +249,6 @@ impl Wear {
             law,
             ball: None,
             jump: 1.0,
-            save_every: 0,
         }
     }
 
@@ -224,12 +290,13 @@ pub enum WearLaw {
 
 impl WearLaw {
     /// The worn depth of a cell over an increment, m: pressure `p` and
-    /// tractions `q` (each the mean of the increment's two ends, the
-    /// trapezoidal rule of the dissipation) and slip increment `ds`.
+    /// tractions `q` at the increment's end (where the implicit law of
+    /// Coulomb friction in increments puts a slipping cell's traction,
+    /// PHYSICS.md §5b) and slip increment `ds`.
     pub fn depth(&self, p: f64, q: [f64; 2], ds: [f64; 2]) -> f64 {
         match *self {
             WearLaw::Archard { k } => k * p.max(0.0) * ds[0].hypot(ds[1]),
-            WearLaw::Energy { alpha } => alpha * (q[0] * ds[0] + q[1] * ds[1]).abs(),
+            WearLaw::Energy { alpha } => alpha * (q[0] * ds[0] + q[1] * ds[1]).max(0.0),
         }
     }
 
@@ -244,9 +311,32 @@ impl WearLaw {
                 format!("the wear coefficient must be finite and ≥ 0, got {v}"),
             ));
         }
+        if v > MAX_WEAR_COEFFICIENT {
+            return Err(SolverError::invalid(
+                name,
+                format!("the wear coefficient {v:e} m³/J is above {MAX_WEAR_COEFFICIENT:e} m³/J (0.1 mm³/(N·m)), more than any measured wear: at that rate a contact wears through its own approach in a few slips"),
+            ));
+        }
         Ok(())
     }
 }
+
+/// The largest wear coefficient (Archard's k or the energy law's α) a path
+/// accepts, m³/J (0.1 mm³/(N·m)): ten times the severe adhesive wear of
+/// metals (k ≈ 1e-2 mm³/(N·m)); fretting measures 1e-6 to 1e-4. A k of
+/// 1e308 gave a worn depth of 3e300 m, and 100 mm³/(N·m) wore 4.6 times the
+/// approach in one cycle (#59 item 2).
+pub const MAX_WEAR_COEFFICIENT: f64 = 1e-10;
+
+/// A shift turning point (displacement control) may reach this many times
+/// the domain's side, m/m: a rig's stroke beyond it slides the ball across
+/// more than the domain, and 1e300 µm gave NaN forces (#59 item 5).
+pub const MAX_SHIFT_DOMAINS: f64 = 10.0;
+
+/// The smallest nonzero shift turning point, m: a picometre, below any
+/// displacement a rig resolves (1e-300 µm gave a loop whose force
+/// amplitude and energies were 0 and null).
+pub const MIN_SHIFT_M: f64 = 1e-12;
 
 impl LoadHistory {
     /// True when the turning points are shifts of the ball (`shifts_m`).
@@ -284,6 +374,47 @@ impl LoadHistory {
             }
         }
         pts
+    }
+
+    /// The increments the path is expected to take (what `check` prices):
+    /// fixed ones exactly; auto ones as the error estimate chose them on
+    /// Table 1(a) Fe (docs/performance.md, "Increments chosen by the
+    /// path"): one per segment at a constant normal load uncoupled,
+    /// [`AUTO_COUPLED_INCREMENTS`] coupled where the tangential load moves,
+    /// as many as the normal load's change asks for ([`AUTO_LOAD_STEP`]),
+    /// and with a wear law as many as its depth a segment `worn_segment`
+    /// (relative to the approach, the cycle jump included) asks for; the
+    /// cycles looked at in their sampled increments.
+    pub fn expected_increments(&self, load: &Load, coupling: bool, worn_segment: f64) -> usize {
+        let points = self.turning_points(load);
+        let looked_at = looked_at_segments(&points, self.sampling.every);
+        let cycles_from = full_cycles(&points).first().map_or(usize::MAX, |&t| t - 2);
+        let total: usize = points
+            .windows(2)
+            .enumerate()
+            .map(|(j, w)| match self.increments {
+                Increments::Fixed(k) => k,
+                Increments::Auto { .. }
+                    if self.sampling.increments > 0 && looked_at.contains(&j) =>
+                {
+                    self.sampling.increments
+                }
+                Increments::Auto { tolerance } => {
+                    let (a, b) = (w[0], w[1]);
+                    let dp = (b.0 / a.0).ln().abs();
+                    let by_load = (dp / (AUTO_LOAD_STEP * tolerance)).ceil() as usize;
+                    let by_path = if coupling && a.1 != b.1 {
+                        AUTO_COUPLED_INCREMENTS
+                    } else {
+                        1
+                    };
+                    let worn = if j >= cycles_from { worn_segment } else { 0.0 };
+                    let by_wear = (worn / (AUTO_WEAR_STEP * tolerance)).ceil() as usize;
+                    by_load.max(by_path).max(by_wear)
+                }
+            })
+            .sum();
+        total.max(1)
     }
 
     /// Rejects impossible paths, naming `history.<key>[index]`.
@@ -354,24 +485,91 @@ impl LoadHistory {
                 )?;
             }
         }
-        if self.steps_per_segment == 0 {
-            return Err(SolverError::invalid(
-                "history.steps_per_segment",
-                "must be at least 1",
-            ));
+        match self.increments {
+            Increments::Fixed(0) => {
+                return Err(SolverError::invalid(
+                    "history.steps_per_segment",
+                    "must be at least 1 (or \"auto\")",
+                ))
+            }
+            Increments::Fixed(k) => {
+                let total = k.saturating_mul(n);
+                if total > MAX_HISTORY_STEPS {
+                    return Err(SolverError::invalid(
+                        "history.steps_per_segment",
+                        format!(
+                            "{k} increments per segment over {n} turning points make {total} increments, more than {MAX_HISTORY_STEPS}"
+                        ),
+                    ));
+                }
+            }
+            Increments::Auto { tolerance } => {
+                if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 0.1) {
+                    return Err(SolverError::invalid(
+                        "history.tolerance",
+                        format!("must be above 0 and below 0.1, got {tolerance}"),
+                    ));
+                }
+            }
         }
-        let total = self.steps_per_segment.saturating_mul(n);
-        if total > MAX_HISTORY_STEPS {
+        let sampled = self.sampling.increments.saturating_mul(2 * n);
+        if sampled > MAX_HISTORY_STEPS {
             return Err(SolverError::invalid(
-                "history.steps_per_segment",
+                "history.loop_increments",
                 format!(
-                    "{} increments per segment over {n} turning points make {total} increments, more than {MAX_HISTORY_STEPS}",
-                    self.steps_per_segment
+                    "{} increments per segment of the sampled cycles could make {sampled} increments, more than {MAX_HISTORY_STEPS}",
+                    self.sampling.increments
                 ),
             ));
         }
         Ok(())
     }
+}
+
+/// The segments (0-based) of the cycles someone looks at: those of every
+/// `every`-th full cycle and of the last (`every` = 0: the last only); a
+/// path without a full cycle (a loading, an unloading) is looked at whole.
+pub(crate) fn looked_at_segments(points: &[(f64, f64)], every: usize) -> Vec<usize> {
+    let ends = full_cycles(points);
+    if ends.is_empty() {
+        return (0..points.len().saturating_sub(1)).collect();
+    }
+    let mut out = Vec::new();
+    for (c, &t) in ends.iter().enumerate() {
+        let number = c + 1;
+        if number == ends.len() || (every > 0 && number % every == 0) {
+            out.extend([t - 2, t - 1]);
+        }
+    }
+    out
+}
+
+/// Whether turning points `a` and `b` are the same (to 1e-12 of their size).
+pub(crate) fn same_point(a: (f64, f64), b: (f64, f64)) -> bool {
+    let scale = a.0.abs().max(b.0.abs());
+    (a.0 - b.0).abs() <= 1e-12 * scale && (a.1 - b.1).abs() <= 1e-12 * scale
+}
+
+/// Whether reaching turning point `t` closes a full cycle: the two
+/// segments before it return to the point they left.
+pub(crate) fn closes_cycle(points: &[(f64, f64)], t: usize) -> bool {
+    t >= 2
+        && t < points.len()
+        && same_point(points[t], points[t - 2])
+        && !same_point(points[t], points[t - 1])
+}
+
+/// The turning points that close the path's full cycles, one after
+/// another: 0 → +A → −A → +A → −A → +A closes two, at the second and the
+/// third +A (the −A → +A → −A between them is not a third).
+pub(crate) fn full_cycles(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut ends: Vec<usize> = Vec::new();
+    for t in 0..points.len() {
+        if closes_cycle(points, t) && ends.last().is_none_or(|&e| t >= e + 2) {
+            ends.push(t);
+        }
+    }
+    ends
 }
 
 /// Everything that defines one case.
@@ -508,6 +706,53 @@ impl CaseSpec {
         }
     }
 
+    /// A rough estimate of the depth one segment of the path's cycles
+    /// wears, relative to the approach, its cycle jump included (what
+    /// `check` prices a wear path's auto increments by; 0 without wear):
+    /// the law's rate at Hertz's peak pressure over the segment's slip (the
+    /// loop's width 2δ(F*) = 2δ*(1 − (1 − F*/μP)^(2/3)), or 2Δ under
+    /// displacement control), times 0.08, the share the slip annulus makes
+    /// of it (fitted: Table 1(a) Fe at 128², k = 1e-5 mm³/(N·m), 10⁴
+    /// cycles as 100 simulated wore 2.2e-5 of the approach a segment).
+    pub fn worn_per_segment(&self) -> f64 {
+        let Some(h) = &self.history else {
+            return 0.0;
+        };
+        let Some(wear) = &h.wear else {
+            return 0.0;
+        };
+        let load = &self.load;
+        let (p, mu) = (load.normal_force_n, load.friction);
+        let a = (3.0 * p * load.indenter_radius_m / (4.0 * self.contact_modulus())).cbrt();
+        let approach = a * a / load.indenter_radius_m;
+        let p_h = 3.0 * p / (2.0 * std::f64::consts::PI * a * a);
+        let delta_star = mu * p / (a * self.mindlin_k_e());
+        let slip = match &h.shifts_m {
+            Some(d) => 2.0 * d.iter().fold(0.0_f64, |m, v| m.max(v.abs())),
+            None => {
+                let f = h
+                    .tangential_ratios
+                    .iter()
+                    .fold(0.0_f64, |m, v| m.max(v.abs()));
+                2.0 * delta_star * (1.0 - (1.0 - f.min(1.0)).powf(2.0 / 3.0))
+            }
+        };
+        let rate = |law: &WearLaw| match *law {
+            WearLaw::Archard { k } => k,
+            WearLaw::Energy { alpha } => alpha * mu,
+        };
+        let rate = rate(&wear.law) + wear.ball.as_ref().map_or(0.0, rate);
+        0.08 * rate * p_h * slip * wear.jump / approach
+    }
+
+    /// The increments this case's load path is expected to take (see
+    /// [`LoadHistory::expected_increments`]); 1 without a path.
+    pub fn expected_increments(&self) -> usize {
+        self.history.as_ref().map_or(1, |h| {
+            h.expected_increments(&self.load, self.numerics.coupling, self.worn_per_segment())
+        })
+    }
+
     /// The same case on the flat surface: the K_E calibration twin.
     pub fn flat_twin(&self) -> CaseSpec {
         CaseSpec {
@@ -557,6 +802,23 @@ impl CaseSpec {
             ));
         }
         positive("grid.dx", grid.dx, "the cell size")?;
+        if let Some(shifts) = self.history.as_ref().and_then(|h| h.shifts_m.as_ref()) {
+            let side = grid.n as f64 * grid.dx;
+            for (j, &v) in shifts.iter().enumerate() {
+                if v != 0.0 && !(MIN_SHIFT_M..=MAX_SHIFT_DOMAINS * side).contains(&v.abs()) {
+                    return Err(SolverError::invalid(
+                        &format!("history.shifts_m[{j}]"),
+                        format!(
+                            "a shift of {:e} µm is outside {:e} µm to {:e} µm ({MAX_SHIFT_DOMAINS} times the domain's side of {:e} µm); give 0 or a shift in that range",
+                            v * 1e6,
+                            MIN_SHIFT_M * 1e6,
+                            MAX_SHIFT_DOMAINS * side * 1e6,
+                            side * 1e6
+                        ),
+                    ));
+                }
+            }
+        }
         if grid.dy != grid.dx {
             return Err(SolverError::invalid(
                 "grid.dy",

@@ -132,6 +132,8 @@ pub(crate) fn solve_partial_slip(
         target: Target::Force(spec.load.tangential_force()),
         previous: None,
         tolerance_scale: 1.0,
+        coupling_tolerance: spec.numerics_in_effect().coupling_tolerance,
+        tangential_tolerance: spec.numerics_in_effect().tangential_tolerance,
     };
     solve_step(res, spec, h0, normal0, &step)
 }
@@ -188,6 +190,15 @@ pub(crate) struct Step<'a> {
     /// stalled near 1e-6 for thousands of iterations: 20 steps of 0.6 μP
     /// on Table 1a, 128², 14 of 20 increments not converged in 5000).
     pub tolerance_scale: f64,
+    /// The coupling loop's tolerance for this step (the relative change of
+    /// the pressure between passes): the configured one, or a looser one
+    /// for an increment inside a load path's segment (see
+    /// `history::INTERIOR_COUPLING`).
+    pub coupling_tolerance: f64,
+    /// The tangential solves' KKT tolerance for this step (before
+    /// `tolerance_scale`): the configured one, or a looser one inside a
+    /// load path's segment.
+    pub tangential_tolerance: f64,
 }
 
 /// One step of tangential loading (and, coupled, the coupling loop) from the
@@ -252,7 +263,8 @@ pub(crate) fn solve_step(
         for k in 1..=num.max_coupling_iterations {
             crate::base::progress::pass(num.coupling.then_some(k))?;
             coupling_iterations = k;
-            let exact_pass = !num.coupling || prev_change < 10.0 * num.coupling_tolerance;
+            let coupling_tolerance = step.coupling_tolerance;
+            let exact_pass = !num.coupling || prev_change < 10.0 * coupling_tolerance;
             // In the final passes the tangential residual must not show as a
             // change of p above the coupling tolerance: with the default
             // coupling tolerance the KKT tolerance stays as configured; a
@@ -260,14 +272,14 @@ pub(crate) fn solve_step(
             // the tangential residual per pass).
             let (tan_tol, normal_tol) = if exact_pass {
                 (
-                    num.tangential_tolerance
-                        .min(100.0 * num.coupling_tolerance)
+                    step.tangential_tolerance
+                        .min(100.0 * coupling_tolerance)
                         .max(1e-12),
                     tol,
                 )
             } else {
                 (
-                    num.tangential_tolerance.max(0.1 * prev_change),
+                    step.tangential_tolerance.max(0.1 * prev_change),
                     tol.max(1e-2 * prev_change),
                 )
             };
@@ -392,7 +404,7 @@ pub(crate) fn solve_step(
             approach = nsol.approach;
             plastic = nsol.plastic;
             // One more tangential solve at the updated pressure closes the loop.
-            if coupling_change < num.coupling_tolerance && exact_pass {
+            if coupling_change < coupling_tolerance && exact_pass {
                 coupling_converged = true;
             }
             prev_change = coupling_change;

@@ -100,6 +100,9 @@ pub(crate) struct CycleRows {
 pub(crate) struct Wearing {
     wear: Wear,
     grid: Grid,
+    /// The cycle jump of the current segment: the wear's own within the
+    /// full cycles, 1 on the first loading (which happens once).
+    jump_now: f64,
     /// The substrate's worn depth in its own frame (the grid's cells at
     /// the path's start; the point under cell x after a slip s = δt − u
     /// there is the one at x + s), m.
@@ -132,6 +135,7 @@ impl Wearing {
         Wearing {
             wear,
             grid,
+            jump_now: 1.0,
             worn: vec![0.0; len],
             ball: vec![0.0; ball_len],
             dh: vec![0.0; len],
@@ -150,12 +154,20 @@ impl Wearing {
         self.wear
     }
 
-    /// Cell `i`'s wear over an increment: mean pressure `pm` and tractions
-    /// `q`, slip increment `ds`.
-    pub fn wear_cell(&mut self, i: usize, pm: f64, q: [f64; 2], ds: [f64; 2]) {
+    /// Forgets the last increment's depths (a cell out of contact over the
+    /// whole increment wears nothing and is not visited).
+    pub fn clear_increment(&mut self) {
+        self.dh.iter_mut().for_each(|d| *d = 0.0);
+        self.dh_ball.iter_mut().for_each(|d| *d = 0.0);
+    }
+
+    /// Cell `i`'s wear over an increment: the pressure `p` and tractions
+    /// `q` its dissipation is taken at (the end's, by the implicit law of
+    /// PHYSICS.md §5b), slip increment `ds`.
+    pub fn wear_cell(&mut self, i: usize, p: f64, q: [f64; 2], ds: [f64; 2]) {
         let depth = |law: crate::model::spec::WearLaw| {
-            if pm > 0.0 {
-                law.depth(pm, q, ds)
+            if p > 0.0 {
+                law.depth(p, q, ds)
             } else {
                 0.0
             }
@@ -166,29 +178,52 @@ impl Wearing {
         }
     }
 
-    /// True with a cycle jump: the wear is taken at the pressure it leaves.
-    pub fn implicit(&self) -> bool {
-        self.wear.jump != 1.0
+    /// The segments that follow are part of the full cycles (`true`: their
+    /// wear is applied the cycle jump's times) or come before them (the
+    /// first loading, worn once).
+    pub fn set_cycles(&mut self, cycles: bool) {
+        self.jump_now = if cycles { self.wear.jump } else { 1.0 };
     }
 
-    /// After an increment's cells (pressures `p0` at its start, `p1` at
-    /// its end; `slip_mid` the cells' slip δt − u halfway through it, m,
-    /// which places the substrate's wear in its frame): without
-    /// a jump the wear is applied now; with one, the layer
+    /// True with a cycle jump in the current segment: the wear is taken at
+    /// the pressure it leaves.
+    pub fn implicit(&self) -> bool {
+        self.jump_now != 1.0
+    }
+
+    /// The depth a cell's increment wears, substrate and ball together,
+    /// the current cycle jump included, m, from its end pressure `p`,
+    /// tractions `q` and slip increment `ds` (what [`Wearing::wear_cell`]
+    /// records, without recording it).
+    pub fn depth_law(&self) -> impl Fn(f64, [f64; 2], [f64; 2]) -> f64 + '_ {
+        move |p, q, ds| {
+            if p > 0.0 {
+                let ball = self.wear.ball.map_or(0.0, |b| b.depth(p, q, ds));
+                (self.wear.law.depth(p, q, ds) + ball) * self.jump_now
+            } else {
+                0.0
+            }
+        }
+    }
+
+    /// After an increment's cells (pressure `p` at its end, which their
+    /// depths were taken at; `slip_mid` the cells' slip δt − u halfway
+    /// through it, m, which places the substrate's wear in its frame):
+    /// without a jump the wear is applied now; with one, the layer
     /// [`Wearing::layer`] is made for the normal solve and
     /// [`Wearing::commit`] applies it.
-    pub fn prepare(&mut self, p0: &[f64], p1: &[f64], slip_mid: Slip) {
+    pub fn prepare(&mut self, p: &[f64], slip_mid: Slip) {
         if !self.implicit() {
             self.apply(slip_mid);
             return;
         }
-        let jump = self.wear.jump;
-        let rate = |d: &mut f64, pm: f64| *d = if pm > 0.0 { jump * *d / pm } else { 0.0 };
+        let jump = self.jump_now;
+        let rate = |d: &mut f64, p: f64| *d = if p > 0.0 { jump * *d / p } else { 0.0 };
         for (i, d) in self.dh.iter_mut().enumerate() {
-            rate(d, 0.5 * (p0[i] + p1[i]));
+            rate(d, p[i]);
         }
         for (i, d) in self.dh_ball.iter_mut().enumerate() {
-            rate(d, 0.5 * (p0[i] + p1[i]));
+            rate(d, p[i]);
         }
         self.layer.clear();
         self.layer.extend_from_slice(&self.dh);

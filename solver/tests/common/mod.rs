@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod axisym;
+pub mod md;
 
 use solver::influence::isotropic_cell;
 use solver::normal::{solve_normal, NormalCache, NormalProblem};
