@@ -54,7 +54,7 @@ def read_levelled(path):
     levelled = topo.detrend(detrend_mode="height")
     h = np.asarray(levelled.heights(), dtype=np.float64) * f
     raw = np.asarray(topo.heights(), dtype=np.float64) * f
-    dx, dy = (v * f for v in topo.pixel_size)
+    dx, dy = (float(v) * f for v in topo.pixel_size)
     return raw, h, dx, dy
 
 
@@ -188,11 +188,11 @@ def main():
         f"P = {a.load_n} N, E = 210 GPa, ν = 0.3; tol {a.tol}"
     )
     print()
-    print("| quantity | mpcontact | contactmechanics 1.8.3 | difference |")
+    print("| quantity | mpcontact | contactmechanics 1.8.3 | relative difference |")
     print("|---|---|---|---|")
     for name, x, y in rows:
-        diff = "" if name in ("iterations", "time (s)") else f"{100 * (x / y - 1):+.3f} %"
-        print(f"| {name} | {x:.6g} | {y:.6g} | {diff} |")
+        diff = "" if name in ("iterations", "time (s)") else f"{x / y - 1:+.1e}"
+        print(f"| {name} | {x:.8g} | {y:.8g} | {diff} |")
 
 
 if __name__ == "__main__":
