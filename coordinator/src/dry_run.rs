@@ -221,6 +221,12 @@ fn scan_lines(name: &str, r: &crate::config::ScanReport, first: bool) -> String 
             g.sa_um, g.sq_um, g.sz_um, g.sdq
         )
     };
+    // Lengths to the nanometre, without trailing zeros (a width of n
+    // pixels is often a last bit off its decimal value).
+    let um = |v: f64| {
+        let t = format!("{v:.3}");
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
     let mut s = String::new();
     if first {
         s += &format!(
@@ -228,22 +234,23 @@ fn scan_lines(name: &str, r: &crate::config::ScanReport, first: bool) -> String 
             r.source,
             r.pixels[0],
             r.pixels[1],
-            r.pixel_um[0],
-            r.pixel_um[1],
-            r.extent_um[0],
-            r.extent_um[1],
+            um(r.pixel_um[0]),
+            um(r.pixel_um[1]),
+            um(r.extent_um[0]),
+            um(r.extent_um[1]),
             r.missing_points,
             r.missing,
             r.levelling,
-            r.apex_um[0],
-            r.apex_um[1],
+            um(r.apex_um[0]),
+            um(r.apex_um[1]),
             rough(&r.scan),
         );
     }
     s += &format!(
-        "           on cells of {} x {} µm: {}",
-        r.cell_um[0],
-        r.cell_um[1],
+        "           on cells of {} x {} µm ({}): {}",
+        um(r.cell_um[0]),
+        um(r.cell_um[1]),
+        r.sampling,
         rough(&r.grid)
     );
     s

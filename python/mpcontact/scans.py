@@ -135,7 +135,7 @@ def with_scan(cfg, name, source, sweep=True, **keys):
     }
     for key, value in keys.items():
         items[f"surfaces.{name}.{key}"] = value
-    if sweep and name not in out.surfaces():
-        items["sweep.surfaces"] = list(out.surfaces()) + [name]
+    if sweep and name not in out.surfaces:
+        items["sweep.surfaces"] = list(out.surfaces) + [name]
     out.set_many(items)
     return out

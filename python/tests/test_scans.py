@@ -67,12 +67,14 @@ def test_x3p_reading_equals_surfacetopography_to_the_bit(
     want = written if precision == "D" else written.astype(np.float32).astype(np.float64)
     assert ours[known].tobytes() == want[known].tobytes()
     # Pixel sizes as the file gives them, and SurfaceTopography's extents
-    # (its increment times the points) to the bit.
+    # (its increment times the points) and pixel sizes to the bit.
     assert (odx, ody) == (dx, dy)
     sx, sy = topo.physical_sizes
     assert np.float64(odx * nx).tobytes() == np.float64(sx).tobytes()
     assert np.float64(ody * ny).tobytes() == np.float64(sy).tobytes()
     px, py = topo.pixel_size
+    assert np.float64(px).tobytes() == np.float64(odx).tobytes()
+    assert np.float64(py).tobytes() == np.float64(ody).tobytes()
     print(
         f"{name}: {nx} x {ny}, pixel {odx!r} x {ody!r} (SurfaceTopography {px!r} x {py!r})"
     )
@@ -111,7 +113,7 @@ def test_a_topography_object_is_a_surface_of_a_case(tmp_path):
     named = mpcontact.with_scan(cfg, "b", out)
     again = mpcontact.solve(named, surface="b")
     assert again.scalars["mu_a"] == res.scalars["mu_a"]
-    assert "b" in named.surfaces()
+    assert "b" in named.surfaces
 
 
 def test_missing_surfacetopography_is_a_clear_message(monkeypatch, tmp_path):
