@@ -121,6 +121,13 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     for w in config.unresolved_patterns(&config.sweep.surfaces)? {
         let _ = writeln!(s, "warning:   {w}");
     }
+    for name in &config.sweep.surfaces {
+        for level in 0..config.convergence.levels {
+            if let Some(r) = config.scan_report(name, level)? {
+                let _ = writeln!(s, "{}", scan_lines(name, &r, level == 0));
+            }
+        }
+    }
     let shown: Vec<String> = angles.iter().map(|a| format!("{a}")).collect();
     let _ = writeln!(s, "angles:    {} ({} deg)", angles.len(), shown.join(", "));
     let mut ball_axis = match &config.sweep.indenters {
@@ -203,4 +210,48 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         solving / cases.len() as f64
     );
     Ok(s)
+}
+
+/// What `check` says of a scan or random surface on one grid: the scan
+/// (first level only) and its roughness there.
+fn scan_lines(name: &str, r: &crate::config::ScanReport, first: bool) -> String {
+    let rough = |g: &crate::config::RoughnessUm| {
+        format!(
+            "Sa {:.4} µm, Sq {:.4} µm, Sz {:.4} µm, Sdq {:.4}",
+            g.sa_um, g.sq_um, g.sz_um, g.sdq
+        )
+    };
+    // Lengths to the nanometre, without trailing zeros (a width of n
+    // pixels is often a last bit off its decimal value).
+    let um = |v: f64| {
+        let t = format!("{v:.3}");
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let mut s = String::new();
+    if first {
+        s += &format!(
+            "scan:      {name}: {}, {} x {} pixels of {} x {} µm ({} x {} µm), {} missing ({}), levelling {}, apex at ({}, {}) µm\n           as prepared: {}\n",
+            r.source,
+            r.pixels[0],
+            r.pixels[1],
+            um(r.pixel_um[0]),
+            um(r.pixel_um[1]),
+            um(r.extent_um[0]),
+            um(r.extent_um[1]),
+            r.missing_points,
+            r.missing,
+            r.levelling,
+            um(r.apex_um[0]),
+            um(r.apex_um[1]),
+            rough(&r.scan),
+        );
+    }
+    s += &format!(
+        "           on cells of {} x {} µm ({}): {}",
+        um(r.cell_um[0]),
+        um(r.cell_um[1]),
+        r.sampling,
+        rough(&r.grid)
+    );
+    s
 }

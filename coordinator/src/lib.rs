@@ -9,7 +9,7 @@
 //! Layers, each importing only from itself and those before it (checked by
 //! the workspace's `tests/tests/layers.rs`, which lists the modules in
 //! order): foundations (`case`, `convergence`, `float_text`,
-//! `solve_progress`) → `config` →
+//! `solve_progress`, `scan_file`) → `config` →
 //! `memory`, `cost`, `output` → `solve`, `dry_run`, `shard` → `run`.
 
 pub mod case;
@@ -21,6 +21,7 @@ pub mod float_text;
 pub mod memory;
 pub mod output;
 pub mod run;
+pub mod scan_file;
 pub mod shard;
 pub mod solve;
 pub mod solve_progress;

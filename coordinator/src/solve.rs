@@ -65,6 +65,10 @@ pub struct CaseJson<'a> {
     /// the fatigue parameter (`crate::output::stress`).
     #[serde(skip_serializing_if = "Option::is_none")]
     stress: Option<&'a crate::output::stress::StressScalars>,
+    /// On a scan or random surface: its source, pixels, preparation and
+    /// roughness (Sa, Sq, Sz, Sdq) as prepared and on this grid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    surface_scan: Option<&'a crate::config::ScanReport>,
 }
 
 /// Options of `mpcontact solve`.
@@ -99,6 +103,9 @@ pub struct CaseChoice {
     pub spec: CaseSpec,
     /// `[stress]` of the config: stresses below the surface after the solve.
     pub stress: Option<crate::config::StressCfg>,
+    /// A scan or random surface: what it is and its roughness on this
+    /// case's grid (`case.json`'s `surface_scan`).
+    pub scan: Option<crate::config::ScanReport>,
 }
 
 impl CaseChoice {
@@ -123,7 +130,9 @@ impl CaseChoice {
         let surface = surface.unwrap_or(&config.sweep.surfaces[0]);
         let angle = Self::angle(config, angle_deg)?;
         let spec = config.spec(material, surface, angle)?;
-        Self::checked(config, material, surface, angle, spec)
+        let mut case = Self::checked(config, material, surface, angle, spec)?;
+        case.scan = config.scan_report(surface, 0)?;
+        Ok(case)
     }
 
     /// The same on a surface given directly (Python's height arrays),
@@ -186,6 +195,7 @@ impl CaseChoice {
             angle_deg,
             spec,
             stress: config.stress.clone(),
+            scan: None,
         })
     }
 }
@@ -237,6 +247,7 @@ impl Solved {
                 .and_then(|h| h.regime.as_ref())
                 .map(|_| solver::SLIP_REGIME_DEFINITION),
             stress: self.stress.as_ref().map(|s| &s.scalars),
+            surface_scan: c.scan.as_ref(),
         }
     }
 }
@@ -315,6 +326,19 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
         c.spec.grid.dx,
     ) {
         eprintln!("warning: maps not written: {e:#}");
+    }
+    if let Surface::Heightmap { heights, .. } | Surface::Resampled { heights, .. } = &c.spec.surface
+    {
+        let grid = &c.spec.grid;
+        if let Err(e) = crate::output::maps::write_surface_map(
+            out,
+            &title,
+            heights,
+            &solved.fields,
+            (grid.dx, grid.dy),
+        ) {
+            eprintln!("warning: surface map not written: {e:#}");
+        }
     }
     if let Some(stress) = &solved.stress {
         for w in crate::output::stress::write(out, stress, &title)? {

@@ -65,7 +65,7 @@ fn accepted_keys() -> BTreeSet<String> {
         },
     );
     let surface: SurfaceCfg = toml::from_str(
-        "shape = 'circle'\ndiameter_um = 1.0\nside_um = 1.0\nwidth_um = 1.0\npitch_um = 2.0\nheight_um = 1.0\nlattice = 'square'\nangle_deg = 0.0\nfile = 'x.npy'\nsampling = 'area'\n",
+        "shape = 'circle'\ndiameter_um = 1.0\nside_um = 1.0\nwidth_um = 1.0\npitch_um = 2.0\nheight_um = 1.0\nlattice = 'square'\nangle_deg = 0.0\nfile = 'x.npy'\nsampling = 'area'\npixel_um = [1.0, 1.0]\nlevelling = 'polynomial'\ndegree = 2\nmissing = 'fill'\napex_um = [1.0, 1.0]\nhurst = 0.8\nrms_height_um = 1.0\nrms_slope = 0.1\nshort_cutoff_um = 1.0\nlong_cutoff_um = 10.0\nseed = 1\npixels = 64\n",
     )
     .unwrap();
     c.surfaces.insert("NAME".into(), surface);

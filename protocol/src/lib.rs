@@ -66,7 +66,9 @@ pub use wire::{
 /// issue #38) and a result carries their scalars.
 /// 6: a case's numerics carry the definition of the apparent radii
 /// (`solver.radii`, issue #34).
-pub const PROTOCOL_VERSION: u32 = 6;
+/// 7: a surface may be a scan resampled onto the case's grid
+/// (`Surface::Resampled`, issue #61).
+pub const PROTOCOL_VERSION: u32 = 7;
 
 #[cfg(test)]
 mod tests;

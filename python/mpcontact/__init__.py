@@ -21,6 +21,7 @@ from pathlib import Path
 
 from mpcontact import _native
 from mpcontact._native import Config, SolveError
+from mpcontact.scans import convert, read_scan, scan_file, with_scan
 
 __all__ = [
     "Config",
@@ -28,10 +29,13 @@ __all__ = [
     "RunResult",
     "SolveError",
     "FIELD_NAMES",
+    "convert",
     "kernel",
     "materials",
+    "read_scan",
     "run",
     "solve",
+    "with_scan",
 ]
 
 #: The fields of a solved case, as the CLI's ``.npy`` files are named.
@@ -202,7 +206,11 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
     to the first of ``sweep.indenters``, else ``indenter.material``, else rigid.
     ``surface`` is a name (preset or ``[surfaces.*]``) or an ``(n, n)`` array
     of heights in µm, rows along y — the same as a ``shape = "heightmap"``
-    surface reading that array from a ``.npy`` file.
+    surface reading that array from a ``.npy`` file — or a measured scan:
+    a SurfaceTopography topography object or a ``pathlib.Path`` to any file
+    it reads (or an ``.x3p``), solved as the config's ``shape = "scan"``
+    with its default preparation (plane levelling, missing points refused;
+    :func:`with_scan` sets them).
 
     The GIL is released while solving; Ctrl-C stops the solve with
     ``KeyboardInterrupt``. Raises ``ValueError`` for a bad argument or
@@ -211,7 +219,10 @@ def solve(cfg, material=None, surface=None, angle_deg=None, indenter=None):
     """
     heights = None
     name = surface
-    if surface is not None and not isinstance(surface, str):
+    if hasattr(surface, "heights") or isinstance(surface, os.PathLike):
+        cfg = with_scan(cfg, "scan", surface, sweep=False)
+        name = "scan"
+    elif surface is not None and not isinstance(surface, str):
         import numpy as np
 
         heights = np.ascontiguousarray(surface, dtype=np.float64)

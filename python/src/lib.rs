@@ -152,6 +152,25 @@ impl PyConfig {
         Ok(())
     }
 
+    /// Overrides several keys at once (a dict of key → value), checked
+    /// together: a new `[surfaces.NAME]` table needs its keys in one go.
+    fn set_many(&mut self, items: &Bound<'_, PyDict>) -> PyResult<()> {
+        let mut sets = self.sets.clone();
+        for (key, value) in items.iter() {
+            let key: String = key.extract()?;
+            if key.contains('=') {
+                return Err(PyValueError::new_err(format!(
+                    "set_many: malformed key `{key}` (contains `=`)"
+                )));
+            }
+            let value = to_toml(&value, &key)?;
+            sets.push(format!("{key}={value}"));
+        }
+        self.config = Self::parse(&self.text, self.path.as_deref(), &sets).map_err(value_error)?;
+        self.sets = sets;
+        Ok(())
+    }
+
     /// A copy (later `set`s on either leave the other alone).
     fn copy(&self) -> Self {
         self.clone()
@@ -632,6 +651,53 @@ fn serve_as_worker(py: Python<'_>, run: String, index: usize) -> PyResult<u8> {
     })
 }
 
+/// Reads a scan the CLI reads (`.x3p`; `.npy` of µm with `pixel_um`):
+/// `(heights, dx, dy)` — heights in m, `(ny, nx)`, rows along y, NaN where
+/// missing; pixel sizes in m. The CLI's reader (`coordinator::scan_file`).
+#[pyfunction]
+#[pyo3(signature = (path, pixel_um=None))]
+fn read_scan<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    pixel_um: Option<[f64; 2]>,
+) -> PyResult<(Bound<'py, PyAny>, f64, f64)> {
+    let scan =
+        coordinator::scan_file::read_scan(&path, pixel_um.map(|[x, y]| [x * 1e-6, y * 1e-6]))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let h = PyArray1::from_slice(py, &scan.heights).reshape([scan.ny, scan.nx])?;
+    Ok((h.into_any(), scan.dx, scan.dy))
+}
+
+/// Writes heights (m, `(ny, nx)`, rows along y, NaN where missing) on
+/// pixels of `dx x dy` (m) as an `.x3p` the CLI reads, with f64 (`"D"`)
+/// or f32 (`"F"`) heights.
+#[pyfunction]
+#[pyo3(signature = (path, heights, dx, dy, precision="D"))]
+fn write_x3p(
+    path: PathBuf,
+    heights: PyReadonlyArray2<'_, f64>,
+    dx: f64,
+    dy: f64,
+    precision: &str,
+) -> PyResult<()> {
+    use coordinator::scan_file::x3p::{self, DataType};
+    let dtype = match precision {
+        "D" => DataType::D,
+        "F" => DataType::F,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "precision: `{other}`: \"D\" (f64) or \"F\" (f32)"
+            )))
+        }
+    };
+    let shape = heights.shape();
+    let (ny, nx) = (shape[0], shape[1]);
+    let h: Vec<f64> = heights.as_array().iter().copied().collect();
+    let scan = solver::Scan::new(nx, ny, dx, dy, h)
+        .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))?;
+    x3p::write(&path, &scan, dtype).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
 /// The module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -642,5 +708,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(materials, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(serve_as_worker, m)?)?;
+    m.add_function(wrap_pyfunction!(read_scan, m)?)?;
+    m.add_function(wrap_pyfunction!(write_x3p, m)?)?;
     Ok(())
 }

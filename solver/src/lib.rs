@@ -48,7 +48,10 @@
 //!    `geometry`, `cover`
 //! 2. `green/`, Green's functions: `influence`, `aniso`
 //! 3. `model/`, the description of a case: `material`, `surface`,
-//!    `presets`, `radii` (what an apparent radius is), `spec`
+//!    `roughness` (Sa, Sq, Sz, Sdq of a height map), `scan` (a measured
+//!    topography and its levelling), `resample` (a scan on a case's
+//!    grid), `self_affine` (random surfaces), `presets`, `radii` (what an
+//!    apparent radius is), `spec`
 //! 4. `operators/`, kernels and operators: `fft2`, `operator`, `multilevel`
 //!    (coarse tables), `stress` (depth kernels of the stresses below the
 //!    surface), `kernels` (a kernel's identity, store and build)
@@ -109,6 +112,10 @@ pub use model::radii::{
     Radii, APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
     APPARENT_RADIUS_DEFINITION_MOMENTS,
 };
+pub use model::resample::{resample, resample_two_level};
+pub use model::roughness::{roughness, Roughness};
+pub use model::scan::{Levelling, Missing, Scan, MAX_LEVELLING_DEGREE};
+pub use model::self_affine::{Amplitude, SelfAffine};
 pub use model::spec::{
     CaseSpec, Increments, Load, LoadHistory, LoopSampling, Numerics, TangentialMethod, Wear,
     WearLaw, AUTO_LOAD_STEP, AUTO_TOLERANCE, MAX_GRID_POINTS, MAX_HISTORY_STEPS, MAX_SHIFT_DOMAINS,

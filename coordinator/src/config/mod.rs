@@ -7,7 +7,8 @@
 //! solver error. Each section has its own file with its keys, defaults,
 //! checks and the config keys of its solver parameters, so that a new key
 //! lives in one place: `grid` (`[grid]`, `[indenter]`, `[load]`),
-//! `convergence`, `sweep`, `materials`, `surfaces`, `history`, `stress` and `solving`
+//! `convergence`, `sweep`, `materials`, `surfaces` (and `scan`: measured
+//! and random surfaces), `history`, `stress` and `solving`
 //! (`[solver]`, `[run]`, `[output]`); `toml_text` guards the text itself.
 
 mod convergence;
@@ -15,6 +16,7 @@ mod grid;
 mod history;
 mod materials;
 pub mod orientations;
+mod scan;
 mod solving;
 mod stress;
 mod surfaces;
@@ -29,6 +31,7 @@ pub use history::{
 };
 pub use materials::{CubicCfg, IsoCfg, MaterialCfg, SweepMaterial};
 pub use orientations::{Orientation, OrientationsCfg};
+pub use scan::{PixelCfg, PreparedScan, RoughnessUm, ScanReport};
 pub use solving::{OutputCfg, RunCfg, SolverCfg};
 pub use stress::StressCfg;
 pub use surfaces::{heightmap_surface, read_grid_npy, SurfaceCfg};
@@ -317,12 +320,14 @@ impl Config {
             .iter()
             .map(|s| {
                 let surface = self.surface(s)?;
-                // A height map is sampled on its own grid only.
+                // A height map is sampled on its own grid only; a scan is
+                // resampled onto each level's.
                 let levels = self.convergence.levels;
-                if levels > 1 && matches!(surface, Surface::Heightmap { .. }) {
-                    bail!("convergence.levels = {levels}: surface `{s}` is a height map, sampled on one grid only; ladders need surfaces defined by shape (or levels = 1)");
+                let scan = self.scan(s)?.is_some();
+                if levels > 1 && !scan && matches!(surface, Surface::Heightmap { .. }) {
+                    bail!("convergence.levels = {levels}: surface `{s}` is a height map, sampled on one grid only; ladders need surfaces defined by shape, a scan (shape = \"scan\") or levels = 1");
                 }
-                Ok((s, surface))
+                Ok((s, surface, scan))
             })
             .collect::<Result<Vec<_>>>()?;
         let balls = self.balls()?;
@@ -342,7 +347,7 @@ impl Config {
         } in self.sweep_materials()?
         {
             let m = &m;
-            for (s, surface) in &surfaces {
+            for (s, surface, scan) in &surfaces {
                 for &a in &angles {
                     for &((name, ball), p, d) in &points {
                         let mut key = match name {
@@ -358,18 +363,24 @@ impl Config {
                             ball.clone(),
                             (p, d),
                         );
-                        let finer: Vec<_> = (1..self.convergence.levels)
+                        let finer = (1..self.convergence.levels)
                             .map(|level| {
                                 let grid = self.level_grid(level);
-                                (
+                                let surface = if *scan {
+                                    self.surface_at(s, level)?
+                                } else {
+                                    spec.surface.clone()
+                                };
+                                Ok((
                                     key.clone().at_level(level),
                                     CaseSpec {
                                         grid,
+                                        surface,
                                         ..spec.clone()
                                     },
-                                )
+                                ))
                             })
-                            .collect();
+                            .collect::<Result<Vec<_>>>()?;
                         out.push((key, spec));
                         out.extend(finer);
                     }

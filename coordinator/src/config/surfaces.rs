@@ -1,7 +1,7 @@
 //! `[surfaces.NAME]`: custom surfaces (island lattices, stripes, height
-//! maps read from `.npy` by [`read_grid_npy`]), how a name resolves (tables
-//! first, each built once per config, then presets) and the config keys of
-//! its parameters.
+//! maps read from `.npy` by [`read_grid_npy`]; scans and random surfaces
+//! are `scan`'s), how a name resolves (tables first, each built once per
+//! config and grid, then presets) and the config keys of its parameters.
 
 use super::{within, Config};
 use anyhow::{anyhow, bail, Context, Result};
@@ -40,21 +40,101 @@ pub struct SurfaceCfg {
     pub offset_um: [f64; 2],
     /// Height map: a 2-D float64 `.npy` of heights in µm, shape (N, N) = the grid,
     /// rows along y; a relative path is taken from the config file's directory.
+    /// Scan: an `.x3p`, or an `.npy` of heights in µm with `pixel_um`.
     pub file: Option<String>,
+    /// Scan (`.npy`) or random surface: the pixel size, µm (one number,
+    /// or `[x, y]` for a scan).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pixel_um: Option<super::scan::PixelCfg>,
+    /// Scan or random surface: `none`, `plane` (a scan's default) or
+    /// `polynomial` (with `degree`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub levelling: Option<String>,
+    /// The levelling polynomial's degree.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub degree: Option<usize>,
+    /// Missing points of a scan: `refuse` (default) or `fill`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub missing: Option<String>,
+    /// The scan's point under the ball's apex, µm from its first pixel's
+    /// outer corner (default: the scan's centre).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apex_um: Option<[f64; 2]>,
+    /// Random surface: the Hurst exponent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hurst: Option<f64>,
+    /// Random surface: the rms height, µm (or `rms_slope`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_height_um: Option<f64>,
+    /// Random surface: the rms slope (or `rms_height_um`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_slope: Option<f64>,
+    /// Random surface: the shortest wavelength, µm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub short_cutoff_um: Option<f64>,
+    /// Random surface: the roll-off wavelength, µm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub long_cutoff_um: Option<f64>,
+    /// Random surface: the seed (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Random surface: pixels per side (default: enough to cover the grid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pixels: Option<usize>,
+}
+
+impl SurfaceCfg {
+    /// True when a key of scans or random surfaces is set.
+    fn any_scan_key(&self) -> bool {
+        self.pixel_um.is_some()
+            || self.levelling.is_some()
+            || self.degree.is_some()
+            || self.missing.is_some()
+            || self.apex_um.is_some()
+            || self.hurst.is_some()
+            || self.rms_height_um.is_some()
+            || self.rms_slope.is_some()
+            || self.short_cutoff_um.is_some()
+            || self.long_cutoff_um.is_some()
+            || self.seed.is_some()
+            || self.pixels.is_some()
+    }
+}
+
+/// What a config has built of its surfaces, shared by its clones.
+#[derive(Debug, Default)]
+struct Built {
+    /// Surfaces by name and ladder level (a scan is resampled per level;
+    /// every other surface is built once, at level 0).
+    surfaces: BTreeMap<(String, usize), Surface>,
+    /// Prepared scans by name.
+    scans: BTreeMap<String, std::sync::Arc<super::scan::PreparedScan>>,
 }
 
 /// Built surfaces by name, shared by the clones of one config.
 #[derive(Clone, Debug, Default)]
-pub(super) struct SurfaceCache(std::sync::Arc<std::sync::Mutex<BTreeMap<String, Surface>>>);
+pub(super) struct SurfaceCache(std::sync::Arc<std::sync::Mutex<Built>>);
 
 impl SurfaceCache {
-    fn get(&self, name: &str) -> Option<Surface> {
-        let map = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        map.get(name).cloned()
+    fn lock(&self) -> std::sync::MutexGuard<'_, Built> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
     }
-    fn insert(&self, name: &str, surface: &Surface) {
-        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        map.insert(name.to_string(), surface.clone());
+    fn get(&self, name: &str, level: usize) -> Option<Surface> {
+        self.lock()
+            .surfaces
+            .get(&(name.to_string(), level))
+            .cloned()
+    }
+    fn insert(&self, name: &str, level: usize, surface: &Surface) {
+        self.lock()
+            .surfaces
+            .insert((name.to_string(), level), surface.clone());
+    }
+    pub(super) fn scan(&self, name: &str) -> Option<std::sync::Arc<super::scan::PreparedScan>> {
+        self.lock().scans.get(name).cloned()
+    }
+    pub(super) fn insert_scan(&self, name: &str, p: &std::sync::Arc<super::scan::PreparedScan>) {
+        self.lock().scans.insert(name.to_string(), p.clone());
     }
 }
 
@@ -68,17 +148,33 @@ pub(super) fn surface_key(param: &str) -> String {
 }
 
 impl Config {
-    /// Resolves a surface name: `[surfaces.NAME]` first, then presets.
+    /// Resolves a surface name: `[surfaces.NAME]` first, then presets; a
+    /// scan on the grid of `grid` (ladder level 0).
     pub fn surface(&self, name: &str) -> Result<Surface> {
+        self.surface_at(name, 0)
+    }
+
+    /// A surface on the grid of ladder level `level`: a scan or random
+    /// surface resampled onto it (once per level, shared by its cases);
+    /// every other surface is the same on every grid.
+    pub fn surface_at(&self, name: &str, level: usize) -> Result<Surface> {
         if let Some(s) = self.surfaces.get(name) {
-            if let Some(surface) = self.built_surfaces.get(name) {
+            let scan = self.scan(name)?;
+            let level = if scan.is_some() { level } else { 0 };
+            if let Some(surface) = self.built_surfaces.get(name, level) {
                 return Ok(surface);
             }
-            let surface = build_surface(name, s, self.grid.points, &self.base_dir)?;
-            surface
-                .validate(self.grid.points)
-                .map_err(|e| self.explain(within("surface", e), "", name))?;
-            self.built_surfaces.insert(name, &surface);
+            let surface = match scan {
+                Some(p) => self.scan_on_level(name, &p, level)?,
+                None => {
+                    let surface = build_surface(name, s, self.grid.points, &self.base_dir)?;
+                    surface
+                        .validate(self.grid.points)
+                        .map_err(|e| self.explain(within("surface", e), "", name))?;
+                    surface
+                }
+            };
+            self.built_surfaces.insert(name, level, &surface);
             return Ok(surface);
         }
         solver::presets::surface(name).ok_or_else(|| {
@@ -112,7 +208,7 @@ fn sampling(name: &str, s: &SurfaceCfg) -> Result<Sampling> {
 /// `sampling` (the only key such a table may set).
 fn preset_with_sampling(name: &str, s: &SurfaceCfg) -> Result<Surface> {
     let mut surface = solver::presets::surface(name).ok_or_else(|| {
-        anyhow!("surfaces.{name}.shape: required (`{name}` is not a preset; shapes: flat, circle, square, stripe, heightmap)")
+        anyhow!("surfaces.{name}.shape: required (`{name}` is not a preset; shapes: flat, circle, square, stripe, heightmap, scan, random)")
     })?;
     let others = [
         s.diameter_um,
@@ -126,6 +222,7 @@ fn preset_with_sampling(name: &str, s: &SurfaceCfg) -> Result<Surface> {
     .any(Option::is_some)
         || s.lattice.is_some()
         || s.file.is_some()
+        || s.any_scan_key()
         || s.offset_um != [0.0, 0.0];
     if others {
         bail!("surfaces.{name}: a table named after the preset `{name}` without `shape` may only set `sampling`; give `shape` (and all its dimensions) to define a new surface");
@@ -133,7 +230,7 @@ fn preset_with_sampling(name: &str, s: &SurfaceCfg) -> Result<Surface> {
     let chosen = sampling(name, s)?;
     match &mut surface {
         Surface::Lattice { sampling, .. } | Surface::Stripes { sampling, .. } => *sampling = chosen,
-        Surface::Flat | Surface::Heightmap { .. } => {}
+        Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => {}
     }
     Ok(surface)
 }
@@ -148,6 +245,9 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
     let um = 1e-6;
     if matches!(shape, "flat" | "heightmap") && s.sampling.is_some() {
         bail!("surfaces.{name}.sampling: only patterns (circle, square, stripe) have edges to sample; a {shape} surface has one height per cell");
+    }
+    if s.any_scan_key() {
+        bail!("surfaces.{name}: pixel_um, levelling, degree, missing, apex_um and the random keys are for shape = \"scan\" or \"random\", not \"{shape}\"");
     }
     let surface = match shape {
         "flat" => Surface::Flat,
@@ -193,7 +293,7 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
                 read_grid_npy(&path, n).with_context(|| format!("surfaces.{name}.file"))?;
             heightmap_surface(n, &values)
         }
-        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap)"),
+        other => bail!("surfaces.{name}.shape: unknown shape `{other}` (flat, circle, square, stripe, heightmap, scan, random)"),
     };
     Ok(surface)
 }
@@ -203,45 +303,15 @@ fn build_surface(name: &str, s: &SurfaceCfg, n: usize, base: &Path) -> Result<Su
 /// its header is checked against the grid before any data is read, so a
 /// wrong file costs no more than its header.
 pub fn read_grid_npy(path: &Path, n: usize) -> Result<Vec<f64>> {
-    let meta =
-        std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
-    if !meta.is_file() {
-        bail!("{} is not a regular file", path.display());
-    }
-    let file =
-        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let npy = npyz::NpyFile::new(std::io::BufReader::new(file))
-        .with_context(|| format!("{} is not a .npy file", path.display()))?;
-    let shape = npy.shape().to_vec();
-    if shape != [n as u64, n as u64] {
-        bail!(
-            "{} has shape {shape:?} but the grid is {n} x {n} (grid.points)",
-            path.display()
-        );
-    }
-    if npy.order() != npyz::Order::C {
-        bail!("Fortran-ordered arrays are not supported; save with numpy's default C order");
-    }
-    let size = match npy.dtype() {
-        npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float => t.size_field(),
-        other => bail!(
-            "{}: expected float64 or float32 values, got {}",
-            path.display(),
-            other.descr()
-        ),
-    };
-    if meta.len() < (n * n) as u64 * size {
-        bail!(
-            "{} is {} bytes, too short for {n} x {n} values",
-            path.display(),
-            meta.len()
-        );
-    }
-    let values: Vec<f64> = if size == 4 {
-        npy.into_vec::<f32>()?.into_iter().map(f64::from).collect()
-    } else {
-        npy.into_vec::<f64>()?
-    };
+    let (_, _, values) = crate::scan_file::npy::read_2d(path, |shape| {
+        if shape == [n as u64, n as u64] {
+            Ok(())
+        } else {
+            Err(format!(
+                "has shape {shape:?} but the grid is {n} x {n} (grid.points)"
+            ))
+        }
+    })?;
     Ok(values)
 }
 

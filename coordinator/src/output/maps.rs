@@ -1,9 +1,10 @@
 //! PNG contour maps of one case's surface fields, in the paper's style
 //! (Figs. 4, 5, 7, 8): p/p_H, qx/p_H, qy/p_H, slip magnitude and the
 //! stick/slip map, axes in units of the contact radius, with a colour bar;
-//! and [`Heat`], a rectangular map with marks (the stress planes and
-//! slices). Drawing only (through `plot`); the fields come from
-//! `solver::Fields`.
+//! [`Heat`], a rectangular map with marks (the stress planes and slices);
+//! and the surface a case was solved on with its contact and stick
+//! outlines over it ([`write_surface_map`]). Drawing only (through
+//! `plot`); the fields come from `solver::Fields`.
 
 use anyhow::Result;
 use plotters::prelude::*;
@@ -234,8 +235,10 @@ pub struct Heat<'a> {
     pub y_range: (f64, f64),
     /// Axis names.
     pub axes: (&'a str, &'a str),
-    /// Points to mark.
+    /// Points to mark (black).
     pub marks: &'a [(f64, f64)],
+    /// More points to mark, in white (a second outline).
+    pub light_marks: &'a [(f64, f64)],
 }
 
 /// Draws a [`Heat`] map into `path` (PNG, written whole or not at all).
@@ -300,6 +303,75 @@ impl Figure for Heat<'_> {
                     .map(|&(x, y)| Circle::new((x, y), 2, BLACK.filled())),
             )
             .map_err(err)?;
+        chart
+            .draw_series(
+                m.light_marks
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 2, WHITE.filled())),
+            )
+            .map_err(err)?;
         colour_bar(&bar, m.label, lo, hi)
     }
+}
+
+/// The cells of `inside` (n x n) with a 4-neighbour outside it (or on the
+/// grid's edge): the zone's outline, as cell centres in µm.
+fn outline(inside: &[bool], n: usize, dx: f64, dy: f64) -> Vec<(f64, f64)> {
+    let half = 0.5 * (n as f64 - 1.0);
+    (0..n * n)
+        .filter(|&i| {
+            let (iy, ix) = (i / n, i % n);
+            inside[i]
+                && (ix == 0
+                    || iy == 0
+                    || ix + 1 == n
+                    || iy + 1 == n
+                    || !inside[i - 1]
+                    || !inside[i + 1]
+                    || !inside[i - n]
+                    || !inside[i + n])
+        })
+        .map(|i| {
+            (
+                ((i % n) as f64 - half) * dx * 1e6,
+                ((i / n) as f64 - half) * dy * 1e6,
+            )
+        })
+        .collect()
+}
+
+/// Writes `surface.png` into `dir`: the heights the case was solved on
+/// (µm, n x n cells of `dx x dy`) with the contact's outline (black) and
+/// the stick zone's (white) over them.
+pub fn write_surface_map(
+    dir: &Path,
+    title: &str,
+    heights: &[f64],
+    fields: &Fields,
+    (dx, dy): (f64, f64),
+) -> Result<()> {
+    let n = fields.n;
+    let contact: Vec<bool> = fields.p.iter().map(|&p| p > 0.0).collect();
+    let stick: Vec<bool> = (0..n * n)
+        .map(|i| contact[i] && fields.stick[i] > 0.5)
+        .collect();
+    let values: Vec<f64> = heights.iter().map(|h| h * 1e6).collect();
+    let (x1, y1) = (
+        0.5 * (n as f64 - 1.0) * dx * 1e6,
+        0.5 * (n as f64 - 1.0) * dy * 1e6,
+    );
+    let label = format!("{title}: surface, contact (black) and stick (white) outlines");
+    let heat = Heat {
+        title: &label,
+        label: "height (µm)",
+        cols: n,
+        rows: n,
+        values: &values,
+        x_range: (-x1, x1),
+        y_range: (-y1, y1),
+        axes: ("x (µm)", "y (µm)"),
+        marks: &outline(&contact, n, dx, dy),
+        light_marks: &outline(&stick, n, dx, dy),
+    };
+    write_heat(&dir.join("surface.png"), &heat)
 }

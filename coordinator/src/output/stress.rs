@@ -191,6 +191,7 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
                     y_range: (-ext.1, ext.1),
                     axes: ("x / a", "y / a"),
                     marks: &marks,
+                    light_marks: &[],
                 },
             );
         }
@@ -222,6 +223,7 @@ pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> 
                     y_range: (0.0, -z_max / a),
                     axes: (if line_is_row { "x / a" } else { "y / a" }, "-z / a"),
                     marks: &marks,
+                    light_marks: &[],
                 },
             );
         }

@@ -110,6 +110,17 @@ pub enum Surface {
         /// Heights, m; shared, so that the cases of a sweep hold one copy.
         heights: std::sync::Arc<Vec<f64>>,
     },
+    /// A scan resampled onto the solver grid ([`crate::model::resample`]):
+    /// a height per cell and, when the scan's two levels are kept apart
+    /// (`sampling = "area"`), each cut cell's cover as a pattern's.
+    Resampled {
+        /// Cells per side.
+        n: usize,
+        /// Heights, m, row-major `[iy][ix]`.
+        heights: std::sync::Arc<Vec<f64>>,
+        /// The cover of every cell (`None`: whole cells).
+        cover: Option<std::sync::Arc<Vec<f64>>>,
+    },
 }
 
 fn positive(field: &str, v: f64, what: &str) -> Result<(), SolverError> {
@@ -232,7 +243,15 @@ impl Surface {
                 }
                 Ok(())
             }
-            Surface::Heightmap { n: hn, heights } => {
+            Surface::Resampled {
+                cover: Some(cover), ..
+            } if cover.len() != n * n || cover.iter().any(|c| !(MIN_COVER..=1.0).contains(c)) => {
+                Err(SolverError::invalid(
+                    "cover",
+                    format!("the cover must hold {n} x {n} fractions in [{MIN_COVER}, 1]"),
+                ))
+            }
+            Surface::Heightmap { n: hn, heights } | Surface::Resampled { n: hn, heights, .. } => {
                 if *hn != n || heights.len() != n * n {
                     return Err(SolverError::invalid(
                         "heights",
@@ -267,7 +286,9 @@ impl Surface {
         let mut h = vec![0.0; grid.len()];
         match self {
             Surface::Flat => {}
-            Surface::Heightmap { heights, .. } => h.copy_from_slice(heights),
+            Surface::Heightmap { heights, .. } | Surface::Resampled { heights, .. } => {
+                h.copy_from_slice(heights)
+            }
             Surface::Stripes {
                 width,
                 pitch,
@@ -327,6 +348,12 @@ impl Surface {
     /// [`Surface::cover`]), the fractions of an area-sampled pattern
     /// integrated once for both: what a case needs of its surface.
     pub fn terrain(&self, grid: &Grid) -> Terrain {
+        if let Surface::Resampled { heights, cover, .. } = self {
+            return Terrain {
+                heights: heights.to_vec(),
+                cover: cover.as_ref().map(|c| c.to_vec()),
+            };
+        }
         match self.area_height() {
             Some(height) => {
                 let upper = self.upper_fraction(grid, height);
@@ -371,6 +398,9 @@ impl Surface {
     /// more compliant under its own load
     /// ([`crate::operators::operator::cut_self_factor`], `docs/physics-choices.md`).
     pub fn cover(&self, grid: &Grid) -> Option<Vec<f64>> {
+        if let Surface::Resampled { cover, .. } = self {
+            return cover.as_ref().map(|c| c.to_vec());
+        }
         let height = self.area_height()?;
         cover_of(self.upper_fraction(grid, height))
     }
@@ -394,7 +424,7 @@ impl Surface {
             Surface::Lattice { sampling, .. } | Surface::Stripes { sampling, .. } => {
                 Some(*sampling)
             }
-            Surface::Flat | Surface::Heightmap { .. } => None,
+            Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => None,
         }
     }
 
@@ -409,7 +439,7 @@ impl Surface {
         let (dx, dy) = (grid.dx, grid.dy);
         let half_diagonal = 0.5 * dx.hypot(dy);
         match self {
-            Surface::Flat | Surface::Heightmap { .. } => {}
+            Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => {}
             Surface::Stripes {
                 width,
                 pitch,
@@ -486,7 +516,7 @@ impl Surface {
     /// Area fraction of the surface covered by islands or ridges (0 for flat and height maps).
     pub fn density(&self) -> f64 {
         match self {
-            Surface::Flat | Surface::Heightmap { .. } => 0.0,
+            Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => 0.0,
             Surface::Stripes { width, pitch, .. } => width / pitch,
             Surface::Lattice {
                 island,
@@ -512,7 +542,7 @@ impl Surface {
             Surface::Lattice { pitch, .. } | Surface::Stripes { pitch, .. } => {
                 Some(pitch / grid.dx.max(grid.dy))
             }
-            Surface::Flat | Surface::Heightmap { .. } => None,
+            Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => None,
         }
     }
 
@@ -536,7 +566,7 @@ impl Surface {
                 *height,
                 if *height < 0.0 { "grooves" } else { "ridges" },
             ),
-            Surface::Flat | Surface::Heightmap { .. } => return None,
+            Surface::Flat | Surface::Heightmap { .. } | Surface::Resampled { .. } => return None,
         };
         let upper = if height <= 0.0 {
             1.0 - self.density()
