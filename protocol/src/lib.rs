@@ -66,7 +66,11 @@ pub use wire::{
 /// issue #38) and a result carries their scalars.
 /// 6: a case's numerics carry the definition of the apparent radii
 /// (`solver.radii`, issue #34).
-pub const PROTOCOL_VERSION: u32 = 6;
+/// 7: results carry μa's apparent radii apart from the zones' own radii,
+/// and the pressure's distance from Hertz (issue #59); journals of earlier
+/// versions, whose `contact_radius_m`/`stick_radius_m` were μa's, do not
+/// resume.
+pub const PROTOCOL_VERSION: u32 = 7;
 
 #[cfg(test)]
 mod tests;
