@@ -4,7 +4,7 @@
 //! and, per case, by a sweep; computes nothing the solver did not.
 
 use crate::float_text::fmt_f64;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use plotters::prelude::*;
 use solver::{Grid, HistoryOutput};
 use std::fmt::Write as _;
@@ -166,29 +166,25 @@ impl Figure for Hysteresis<'_> {
 
 /// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`,
 /// and with a wear law the files of [`super::wear::write_wear`].
-/// The table is written first; a picture that cannot be drawn is returned
-/// as a warning, not an error.
+/// The tables are written first; the pictures that could not be drawn are
+/// returned (the caller reports them as lost outputs, an error once the
+/// rest is written). The path's warnings are [`super::wear::wear_warnings`].
 pub fn write_history(
     dir: &Path,
     h: &HistoryOutput,
     grid: &Grid,
     title: &str,
 ) -> Result<Vec<String>> {
-    std::fs::create_dir_all(dir)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     super::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
-    let mut warnings = Vec::new();
+    let mut lost = Vec::new();
     for name in ["hysteresis.png", "hysteresis.svg"] {
         if let Err(e) = plot_hysteresis(&dir.join(name), h, title) {
-            warnings.push(format!("{name}: {e:#}"));
+            lost.push(format!("{name}: {e:#}"));
         }
     }
-    warnings.extend(super::wear::write_wear(dir, h, grid, title)?);
-    warnings.extend(
-        super::wear::wear_warnings(h)
-            .into_iter()
-            .map(|w| format!("{title}: {w}")),
-    );
-    Ok(warnings)
+    lost.extend(super::wear::write_wear(dir, h, grid, title)?);
+    Ok(lost)
 }
 
 #[cfg(test)]
