@@ -809,7 +809,7 @@ impl Figure for Curves {
                 (xlo - xpad)..(xhi + xpad),
                 // Room below the data for a row of crosses per curve with
                 // angles missing, so that one never hides another.
-                (lo - pad * (1.0 + 0.3 * panel.missing.len().saturating_sub(1) as f64))..(hi + pad),
+                (lo - pad * (1.0 + 0.6 * panel.missing.len().saturating_sub(1) as f64))..(hi + pad),
             )?;
             chart
                 .configure_mesh()
@@ -867,7 +867,7 @@ impl Figure for Curves {
             }
             for (k, (name, angles)) in panel.missing.iter().enumerate() {
                 let (color, _) = style_of(name);
-                let floor = lo - pad * (0.5 + 0.3 * k as f64);
+                let floor = lo - pad * (0.5 + 0.6 * k as f64);
                 chart
                     .draw_series(
                         angles
