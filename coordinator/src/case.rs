@@ -9,6 +9,8 @@
 use std::fmt;
 
 use serde::ser::{SerializeStruct, Serializer};
+
+use crate::float_text::fmt_f64;
 use serde::{Deserialize, Serialize};
 
 /// Which case of a sweep: material × surface × force angle, by the names
@@ -111,16 +113,18 @@ impl CaseKey {
     }
 
     /// The fretting-map axes as they appear in ids and paths: `@6000N` for
-    /// a normal load, `@1.5um` for an amplitude (shortest text that reads
-    /// back to the same number, so distinct values give distinct ids);
+    /// a normal load, `@1.5um` for an amplitude: the numbers as in every
+    /// CSV ([`fmt_f64`]: the shortest digits that read back to the same
+    /// number, in exponent form outside [1e-3, 1e7), so distinct values give
+    /// distinct ids and `1e-250` is not spelt out in 264 characters, #59);
     /// empty without those axes.
     pub fn axes_text(&self) -> String {
         let mut t = String::new();
         if let Some(p) = self.normal_n {
-            t.push_str(&format!("@{p}N"));
+            t.push_str(&format!("@{}N", fmt_f64(p)));
         }
         if let Some(a) = self.amplitude_um {
-            t.push_str(&format!("@{a}um"));
+            t.push_str(&format!("@{}um", fmt_f64(a)));
         }
         t
     }
@@ -172,6 +176,13 @@ impl fmt::Display for CaseKey {
         Ok(())
     }
 }
+
+/// The exit status of `mpcontact run`, `merge` and `solve` when they wrote
+/// their outputs but a case has no `ok` result (failed, or
+/// `not_converged`): not 0, so that scripts notice (#59), and not 2, the
+/// status of an error that stopped them. (3 is a worker's,
+/// `protocol::EXIT_LEFT_WAITING`.)
+pub const EXIT_NOT_ALL_OK: u8 = 4;
 
 /// How a recorded case ended. Written as `ok`, `not_converged`, `failed`
 /// (results.csv, journal, case.json); journals of older builds that wrote
@@ -288,6 +299,25 @@ mod tests {
             let back = protocol::decode::<(CaseKey, u32)>(&bytes, "run").unwrap();
             assert_eq!(back.header.body, (k, 7));
         }
+    }
+
+    #[test]
+    fn issue59_item6_map_axes_take_the_shortest_text_that_reads_back() {
+        // 1e-250 µm was spelt out in 264 characters: a file name too long
+        // for the file system, the case's history lost without a word.
+        for (v, text) in [
+            (1e-250, "1e-250"),
+            (1.5, "1.5"),
+            (6000.0, "6000"),
+            (1e7, "1e7"),
+            (1.0 / 3.0, "0.3333333333333333"),
+        ] {
+            let k = CaseKey::new("Fe", "flat", 0.0).with_amplitude(v);
+            assert_eq!(k.axes_text(), format!("@{text}um"));
+            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits());
+        }
+        let k = CaseKey::new("Fe", "flat", 0.0).with_normal_load(f64::MIN_POSITIVE);
+        assert!(k.to_string().len() < 40, "{k}");
     }
 
     #[test]

@@ -227,6 +227,16 @@ fn worker_exe() -> Result<PathBuf> {
     std::env::current_exe().context("cannot locate the mpcontact executable")
 }
 
+/// Success when every case has an `ok` result, else
+/// [`coordinator::case::EXIT_NOT_ALL_OK`] (the outputs are written).
+fn all_ok(ok: bool) -> ExitCode {
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(coordinator::case::EXIT_NOT_ALL_OK)
+    }
+}
+
 /// `--refine L` is `--set convergence.levels=L` (one place for the key).
 fn refine_set(refine: Option<usize>) -> Option<String> {
     refine.map(|levels| format!("convergence.levels={levels}"))
@@ -271,8 +281,8 @@ fn real_main() -> Result<ExitCode> {
                 exe: coordinator::run::WorkerCommand::mpcontact(worker_exe()?),
                 shard,
             };
-            coordinator::run::run_sweep(&args)?;
-            Ok(ExitCode::SUCCESS)
+            let summary = coordinator::run::run_sweep(&args)?;
+            Ok(all_ok(summary.without_result().is_none()))
         }
         Cmd::Solve {
             config,
@@ -300,18 +310,29 @@ fn real_main() -> Result<ExitCode> {
                 },
             )?;
             println!(
-                "a = {:.6e} m, c = {:.6e} m, δz = {:.6e} m, δt = {:.6e} m, p_max = {:.6e} Pa, μa = {} (paper's whole-cell radii: {}), converged = {} → {}",
+                "a = {:.6e} m, c = {:.6e} m, δz = {:.6e} m, δt = {:.6e} m, p_max = {:.6e} Pa, μa = {}{} (paper's whole-cell radii: {}), converged = {} → {}",
                 s.contact_radius_m,
                 s.stick_radius_m,
                 s.delta_z_m,
                 s.delta_t_m,
                 s.p_max_pa,
                 s.mu_a.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
+                if s.mu_a_non_hertz() == Some(true) {
+                    " (flagged: the pressure is not Hertz's)"
+                } else {
+                    ""
+                },
                 s.mu_a_cells.map(|v| format!("{v:.5}")).unwrap_or_else(|| "n/a".into()),
                 s.converged,
                 out.join("case.json").display()
             );
-            Ok(ExitCode::SUCCESS)
+            if !s.converged {
+                eprintln!(
+                    "error: the case did not converge (status not_converged; case.json gives the residuals); its numbers are written but are not a solution (exit status {})",
+                    coordinator::case::EXIT_NOT_ALL_OK
+                );
+            }
+            Ok(all_ok(s.converged))
         }
         Cmd::Merge { shards, out } => {
             let s = coordinator::run::merge_shards(&shards, &out)?;
@@ -324,7 +345,10 @@ fn real_main() -> Result<ExitCode> {
                 s.failed,
                 out.display()
             );
-            Ok(ExitCode::SUCCESS)
+            if let Some(line) = s.without_result() {
+                eprintln!("error: {line}");
+            }
+            Ok(all_ok(s.without_result().is_none()))
         }
         Cmd::Check {
             config,

@@ -26,8 +26,15 @@ pub struct CaseJson<'a> {
     status: Status,
     #[serde(flatten)]
     scalars: &'a CaseScalars,
+    zone_radius_definition: &'static str,
     apparent_radius_definition: &'static str,
     apparent_radius_definition_cells: &'static str,
+    hertz_misfit_definition: &'static str,
+    hertz_misfit_limit: f64,
+    /// μa flagged: the pressure is further from Hertz's than
+    /// `hertz_misfit_limit` (absent without μa).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mu_a_non_hertz: Option<bool>,
     grid_points: usize,
     spacing_m: f64,
     spec: &'a CaseSpec,
@@ -213,6 +220,23 @@ pub struct Solved {
 }
 
 impl Solved {
+    /// The warning of a case whose peak pressure exceeds a preset's
+    /// typical hardness with no `hardness_gpa` to cap it (#59), naming the
+    /// key that would; `None` when it does not.
+    pub fn beyond_hardness(&self) -> Option<String> {
+        let p_max = self.scalars.p_max_pa;
+        let (m, range) = self.case.spec.pressure_beyond_hardness(p_max)?;
+        Some(format!(
+            "p_max = {:.2} GPa exceeds the typical hardness of {} ({:.1}–{:.1} GPa, {}): a real surface yields there; set [materials.{}] hardness_gpa to cap the pressure",
+            p_max / 1e9,
+            m.name,
+            range.low_pa / 1e9,
+            range.high_pa / 1e9,
+            range.what,
+            m.name
+        ))
+    }
+
     /// The `case.json` of this case (serialize it, or turn it into another
     /// serde value).
     pub fn case_json(&self) -> CaseJson<'_> {
@@ -229,8 +253,12 @@ impl Solved {
             angle_deg: c.angle_deg,
             status: Status::of_solved(self.scalars.converged),
             scalars: &self.scalars,
+            zone_radius_definition: solver::ZONE_RADIUS_DEFINITION,
             apparent_radius_definition: c.spec.numerics.radii.definition(),
             apparent_radius_definition_cells: solver::APPARENT_RADIUS_DEFINITION_CELLS,
+            hertz_misfit_definition: solver::HERTZ_MISFIT_DEFINITION,
+            hertz_misfit_limit: solver::HERTZ_MISFIT_LIMIT,
+            mu_a_non_hertz: self.scalars.mu_a_non_hertz(),
             grid_points: c.spec.grid.n,
             spacing_m: c.spec.grid.dx,
             spec: &c.spec,
@@ -303,18 +331,30 @@ pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
 }
 
 /// Writes `case.json`, the fields as `.npy` and their PNG maps into `out`.
+/// The numbers are written first; a picture that cannot be drawn (e.g. no
+/// system font) is an error too, once everything else is written (#59:
+/// no output is lost without a word).
 pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let path = out.join("case.json");
     let json = serde_json::to_string_pretty(&solved.case_json())?;
     crate::output::atomic::write(&path, json.as_bytes())?;
     write_fields(out, &solved.fields)?;
-    // The numbers are written first; a picture that cannot be drawn (e.g. no
-    // system font) is a warning, not a lost result.
     let c = &solved.case;
     let title = format!("{}, {}, ψ = {}°", c.material, c.surface, c.angle_deg);
+    let mut lost = Vec::new();
     if let Some(h) = &solved.scalars.history {
-        for w in crate::output::history::write_history(out, h, &c.spec.grid, &title)? {
+        lost.extend(crate::output::history::write_history(
+            out,
+            h,
+            &c.spec.grid,
+            &title,
+        )?);
+        let increments = crate::output::history::history_warnings(h);
+        for w in crate::output::wear::wear_warnings(h)
+            .into_iter()
+            .chain(increments)
+        {
             eprintln!("warning: {w}");
         }
     }
@@ -325,7 +365,7 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
         &solved.scalars,
         c.spec.grid.dx,
     ) {
-        eprintln!("warning: maps not written: {e:#}");
+        lost.push(format!("maps: {e:#}"));
     }
     if let Surface::Heightmap { heights, .. } | Surface::Resampled { heights, .. } = &c.spec.surface
     {
@@ -341,9 +381,15 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
         }
     }
     if let Some(stress) = &solved.stress {
-        for w in crate::output::stress::write(out, stress, &title)? {
-            eprintln!("warning: {w}");
-        }
+        lost.extend(crate::output::stress::write(out, stress, &title)?);
+    }
+    if !lost.is_empty() {
+        anyhow::bail!(
+            "{} output(s) of {} could not be written (the others were):\n  {}",
+            lost.len(),
+            out.display(),
+            lost.join("\n  ")
+        );
     }
     Ok(())
 }
@@ -363,6 +409,9 @@ pub fn run_solve(config: &Config, args: &SolveArgs) -> Result<CaseScalars> {
     // The line is cleared before anything else is printed (warnings, the result).
     drop(progress);
     let solved = solved?;
+    if let Some(w) = solved.beyond_hardness() {
+        eprintln!("warning: {w}");
+    }
     write_solved(&solved, args.out)?;
     Ok(solved.scalars)
 }
@@ -407,6 +456,32 @@ indenters = ["steel", "rigid"]
                 .unwrap_err()
         );
         assert!(e.contains("--indenter: unknown material `Mithril`"), "{e}");
+    }
+
+    /// Issue #59: island edges on Table 1(c) Cu reach 3.6–16 GPa elastic,
+    /// beyond copper's 0.4–1.2 GPa: `solve` warns, naming
+    /// `materials.Cu.hardness_gpa`; the flat contact (p_H = 0.85 GPa, under
+    /// the range's top) does not, nor does a case with a hardness.
+    #[test]
+    fn issue59_an_elastic_pressure_beyond_a_presets_hardness_warns_naming_the_key() {
+        let text = "[grid]\npoints = 64\nspacing_um = 100.0\n[indenter]\nradius_mm = 200.0\n[load]\nnormal_n = 6000.0\nfriction = 0.3\ntangential_ratio = 0.3\n[sweep]\nmaterials = [\"Cu\"]\nsurfaces = [\"circle-B\", \"flat\"]\nangles_deg = [0.0]\n[solver]\ncoupling = false\n";
+        let solve = |text: &str, surface: &str| {
+            let c = Config::parse(text, &[]).unwrap();
+            solve_in_memory(CaseChoice::new(&c, None, Some(surface), None).unwrap(), 1).unwrap()
+        };
+        let islands = solve(text, "circle-B");
+        let range = solver::presets::hardness_range("Cu").unwrap();
+        assert!(islands.scalars.p_max_pa > range.high_pa);
+        let w = islands.beyond_hardness().expect("a warning");
+        assert!(w.contains("[materials.Cu] hardness_gpa"), "{w}");
+        let flat = solve(text, "flat");
+        assert!(flat.scalars.p_max_pa < range.high_pa);
+        assert_eq!(flat.beyond_hardness(), None);
+        let capped = solve(
+            &format!("{text}[materials.Cu]\nhardness_gpa = 1.0\n"),
+            "circle-B",
+        );
+        assert_eq!(capped.beyond_hardness(), None);
     }
 
     const FE: &str = "[grid]\npoints = 64\nspacing_um = 5.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.28571\n[sweep]\nmaterials = [\"Fe\"]\nangles_deg = [0.0]\n[history]\ntangential_ratios = [0.0, 0.6, -0.6]\nsteps_per_segment = 2\n";

@@ -68,7 +68,11 @@ pub use wire::{
 /// (`solver.radii`, issue #34).
 /// 7: a surface may be a scan resampled onto the case's grid
 /// (`Surface::Resampled`, issue #61).
-pub const PROTOCOL_VERSION: u32 = 7;
+/// 8: results carry μa's apparent radii apart from the zones' own radii,
+/// and the pressure's distance from Hertz (issue #59); journals of earlier
+/// versions, whose `contact_radius_m`/`stick_radius_m` were μa's, do not
+/// resume.
+pub const PROTOCOL_VERSION: u32 = 8;
 
 #[cfg(test)]
 mod tests;

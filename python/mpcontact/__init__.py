@@ -81,7 +81,8 @@ class Result:
         the columns of the CLI's ``history.csv`` (``step``,
         ``normal_force_n``, ``fx_n``, ``fy_n``, ``delta_x_m``, ``delta_y_m``,
         ``delta_z_m``, ``contact_area_m2``, ``stick_area_m2``,
-        ``stick_radius_m``, ``dissipated_j``, ``segment``, ``converged``,
+        ``stick_radius_m`` (the stick zone's own radius, its outline),
+        ``dissipated_j``, ``segment``, ``converged``,
         ``segment_increments`` (the increments the row's segment took), and
         ``worn_volume_m3`` with a wear law, ``plastic_area_m2`` and
         ``plastic_penetration_max_m`` on a surface with a hardness). The per-cycle energy, reversal stiffness and residual shift are in
@@ -129,7 +130,8 @@ class Result:
         ``worn_volume_m3``, ``worn_volume_per_cycle_m3``, ``depth_max_m``,
         ``depth_max_x_m``, ``depth_max_y_m``, ``depth_increment_max_m``,
         ``scar_area_m2``, ``scar_extent_x_m``, ``scar_extent_y_m``,
-        ``contact_radius_m``, ``stick_radius_m``, ``force_amplitude_n``,
+        ``contact_radius_m``, ``stick_radius_m`` (the zones' own radii),
+        ``force_amplitude_n``,
         ``shift_amplitude_m``, ``dissipated_j``, ``regime``,
         ``worn_through_cells``, ``ball_worn_volume_m3``, ``ball_depth_max_m``)."""
         h = self.scalars.get("history")

@@ -440,17 +440,23 @@ fn solve<'py>(
         None => Ok(case),
     })
     .map_err(value_error)?;
-    if let Some(w) = case.unresolved_pattern() {
-        // What the CLI prints on stderr, as a Python warning (stack level
-        // 2: the caller of `mpcontact.solve`).
+    // What the CLI prints on stderr, as Python warnings (stack level 2: the
+    // caller of `mpcontact.solve`).
+    let warn = |w: String| -> PyResult<()> {
         let text = std::ffi::CString::new(w).map_err(|e| PyValueError::new_err(e.to_string()))?;
         let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
-        PyErr::warn(py, &category, &text, 2)?;
+        PyErr::warn(py, &category, &text, 2)
+    };
+    if let Some(w) = case.unresolved_pattern() {
+        warn(w)?;
     }
     let solved = interruptible(py, move || {
         solve_in_memory(case, solver::Threads::available())
     })?
     .map_err(|e| SolveError::new_err(format!("{e:#}")))?;
+    if let Some(w) = solved.beyond_hardness() {
+        warn(w)?;
+    }
     let value = serde_json::to_value(solved.case_json())
         .map_err(|e| PyRuntimeError::new_err(format!("case.json: {e}")))?;
     let scalars = to_py(py, &value)?;

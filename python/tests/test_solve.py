@@ -391,3 +391,37 @@ def test_a_hardness_caps_the_pressure_and_returns_the_dent_as_the_cli(tmp_path, 
     assert plastic["plastic_area_m2"] > 0.0
     assert dent.max() == plastic["penetration_max_m"] > 0.0
     assert res.fields["p"].max() <= hardness_gpa * 1e9
+
+
+def test_an_elastic_pressure_beyond_the_presets_hardness_warns_as_the_cli(tmp_path):
+    # Issue #59: circle-B's island edges on Table 1(c) Cu press far beyond
+    # copper's 0.4-1.2 GPa; Python warns as `mpcontact solve` does, naming
+    # the key that caps the pressure.
+    text = """
+[grid]
+points = 64
+spacing_um = 100.0
+
+[indenter]
+radius_mm = 200.0
+
+[load]
+normal_n = 6000.0
+friction = 0.3
+tangential_ratio = 0.3
+
+[sweep]
+materials = ["Cu"]
+surfaces = ["circle-B"]
+angles_deg = [0.0]
+
+[solver]
+coupling = false
+"""
+    path = tmp_path / "islands.toml"
+    path.write_text(text)
+    with pytest.warns(UserWarning, match=r"\[materials.Cu\] hardness_gpa"):
+        r = mpcontact.solve(mpcontact.Config.from_toml(path))
+    assert r.scalars["p_max_pa"] > 1.2e9
+    assert r.scalars["mu_a_contact_radius_m"] > 0.0
+    assert r.scalars["mu_a_non_hertz"] in (True, False)

@@ -11,15 +11,22 @@ use crate::solve::normal::NormalProblem;
 use crate::solve::resident::{KernelCache, Resident};
 
 /// Fails when any cell of the outermost ring carries pressure: the contact
-/// then reaches the edge of the domain and the result would be wrong.
-fn check_inside(n: usize, p: &[f64]) -> Result<(), SolverError> {
+/// then reaches the edge of the domain and the result would be wrong. With
+/// a hardness the error says that the cap spreads the contact (#59).
+fn check_inside(spec: &CaseSpec, p: &[f64]) -> Result<(), SolverError> {
+    let n = spec.grid.n;
     let active = |i: usize| p[i] > 0.0;
     let touches = (0..n)
         .any(|k| active(k) || active((n - 1) * n + k) || active(k * n) || active(k * n + n - 1));
     if touches {
-        return Err(SolverError::DomainTooSmall {
-            detail: "pressure is non-zero on the outermost cells".into(),
-        });
+        let mut detail = String::from("pressure is non-zero on the outermost cells");
+        if let Some(h) = spec.limits().hardness {
+            detail.push_str(&format!(
+                "; the hardness {:.3e} GPa caps the pressure and spreads the contact (a larger hardness_gpa shrinks it)",
+                h / 1e9
+            ));
+        }
+        return Err(SolverError::DomainTooSmall { detail });
     }
     Ok(())
 }
@@ -37,7 +44,6 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     // resident operator outlives the case.
     res.operator.set_cover(terrain.cover.as_deref());
     let started = std::time::Instant::now();
-    let n = spec.grid.n;
     let h0 = spec.initial_gap_on(&terrain.heights);
     if let Some(history) = &spec.history {
         return solve_history_case(spec, history, res, (&h0, &terrain), started, kernel_seconds);
@@ -48,9 +54,9 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
         hardness: spec.limits().hardness,
         ..NormalProblem::new(&h0, spec.load.normal_force_n)
     })?;
-    check_inside(n, &normal.p)?;
+    check_inside(spec, &normal.p)?;
     let state = crate::solve::coupling::solve_partial_slip(res, spec, &h0, normal)?;
-    check_inside(n, &state.p)?;
+    check_inside(spec, &state.p)?;
     reduce(
         spec,
         &terrain,
@@ -73,7 +79,6 @@ fn solve_history_case(
     started: std::time::Instant,
     kernel_seconds: f64,
 ) -> Result<CaseOutput, SolverError> {
-    let n = spec.grid.n;
     let points = history.turning_points(&spec.load);
     let normal = res.solve_normal_from_rest(&NormalProblem {
         tolerance: spec.numerics.tolerance,
@@ -81,10 +86,10 @@ fn solve_history_case(
         hardness: spec.limits().hardness,
         ..NormalProblem::new(h0, points[0].0)
     })?;
-    check_inside(n, &normal.p)?;
+    check_inside(spec, &normal.p)?;
     let solved =
         crate::solve::history::solve_history(res, spec, history, (h0, terrain), normal, |p| {
-            check_inside(n, p)
+            check_inside(spec, p)
         })?;
     // The final state is reduced as a case under the path's last load.
     let &(p_last, f_last) = points.last().expect("validated: at least one point");

@@ -110,7 +110,7 @@ pub use model::material::{
 };
 pub use model::radii::{
     Radii, APPARENT_RADIUS_DEFINITION, APPARENT_RADIUS_DEFINITION_CELLS,
-    APPARENT_RADIUS_DEFINITION_MOMENTS,
+    APPARENT_RADIUS_DEFINITION_MOMENTS, ZONE_RADIUS_DEFINITION,
 };
 pub use model::resample::{resample, resample_two_level};
 pub use model::roughness::{roughness, Roughness};
@@ -130,7 +130,8 @@ pub use operators::kernels::{
 pub use operators::operator::{Operator, Spectra};
 pub use post::results::{
     calibrate_k_e, calibrate_on_flat, mu_apparent, CaseOutput, CaseScalars, Fields, PlasticScalars,
-    K_E_DEFINITION, K_E_FLAT_CALIBRATED, K_E_ISOTROPIC,
+    HERTZ_MISFIT_DEFINITION, HERTZ_MISFIT_LIMIT, K_E_DEFINITION, K_E_FLAT_CALIBRATED,
+    K_E_ISOTROPIC,
 };
 pub use solve::history::{
     HistoryOutput, HistoryStep, TurningState, WearCycle, DISSIPATION_DEFINITION, SCAR_DEFINITION,

@@ -209,8 +209,8 @@ fn light_tangential_loads_converge_to_cattaneo_mindlin() {
     }
 }
 
-/// `solver.radii = "moments"` (issue #34; the default since issue #47): the
-/// radii from the second moments of p and of μp − |q| on the stick cells
+/// `solver.radii = "moments"` (issue #34; the default since issue #47): μa's
+/// radii (`mu_a_*_radius_m`) from the second moments of p and of μp − |q| on the stick cells
 /// are Hertz's a and Mindlin's c on Table 1a uncoupled, and flat isotropic
 /// μa is μ with them, as with the hull's (measured at 256² of 1 µm: a
 /// −1.1e-5, c −3.5e-4, μa 0.28535 against the hull's 0.28532, μ = 0.28571).
@@ -228,18 +228,25 @@ fn moment_radii_are_hertz_and_mindlin_and_give_mu_on_flat() {
     let s = solve_case(&spec, &mut cache).unwrap().scalars;
     println!(
         "moments: a {:.3e}, c {:.3e} off; μa {:.5} (hull {:.5})",
-        s.contact_radius_m / m.a - 1.0,
-        s.stick_radius_m / m.c - 1.0,
+        s.mu_a_contact_radius_m / m.a - 1.0,
+        s.mu_a_stick_radius_m / m.c - 1.0,
         s.mu_a.unwrap(),
         hull.mu_a.unwrap()
     );
     assert!(s.converged);
-    assert!(rel(s.contact_radius_m, m.a) < 1e-4, "a");
-    assert!(rel(s.stick_radius_m, m.c) < 1e-3, "c");
+    assert!(rel(s.mu_a_contact_radius_m, m.a) < 1e-4, "a");
+    assert!(rel(s.mu_a_stick_radius_m, m.c) < 1e-3, "c");
     assert!(rel(s.mu_a.unwrap(), 0.28571) < 3e-3, "μa");
-    // The same solve: only the radii (and μa through them) differ.
+    // The same solve: only μa's radii (and μa through them) differ; the
+    // zones' own radii are their outlines under either (issue #59).
     assert_eq!(s.delta_t_m.to_bits(), hull.delta_t_m.to_bits());
     assert_eq!(s.stick_area_m2.to_bits(), hull.stick_area_m2.to_bits());
     assert_eq!(s.tangential_iterations, hull.tangential_iterations);
-    assert_ne!(s.contact_radius_m, hull.contact_radius_m);
+    assert_ne!(s.mu_a_contact_radius_m, hull.mu_a_contact_radius_m);
+    assert_eq!(hull.mu_a_contact_radius_m, hull.contact_radius_m);
+    assert_eq!(
+        s.contact_radius_m.to_bits(),
+        hull.contact_radius_m.to_bits()
+    );
+    assert_eq!(s.stick_radius_m.to_bits(), hull.stick_radius_m.to_bits());
 }

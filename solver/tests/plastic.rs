@@ -702,3 +702,52 @@ fn a_hardness_above_the_contact_changes_no_bit_of_a_case() {
         assert!(out.fields.plastic.iter().all(|&w| w == 0.0));
     }
 }
+
+/// Issue #59 item 1: a hardness the domain cannot carry (H = 0.01 GPa on
+/// Table 1(a) Fe at 64² of 5 µm, P/H twenty times the domain's area) came
+/// back `not_converged` with p_max = 505 H, and under a tangential load as
+/// "gross sliding … Σ μp ΔA". Now it is refused before solving, naming the
+/// hardness, wherever the capped contact's least area P/H, as a disc,
+/// reaches the outermost ring of cells (radius (n/2 − 1)·Δ from the centre,
+/// the independent bound here); just inside that bound the case solves,
+/// converged, with the pressure at most H.
+#[test]
+fn issue59_item1_a_hardness_the_domain_cannot_carry_is_refused_naming_it() {
+    let (n, d) = (64, 5.0);
+    let reach = (n as f64 / 2.0 - 1.0) * d * 1e-6;
+    let limit = LOAD_1A / (PI * reach * reach);
+    eprintln!("H at which P/H fills the disc inside the outermost ring: {limit:.4e} Pa");
+    for ratio in [0.0, 0.6] {
+        for cap in [1e7, 1e-291, 0.95 * limit] {
+            let spec = with_hardness(common::table_1a_fe(n, d, true, ratio), cap);
+            match solve_case(&spec, &mut KernelCache::new()) {
+                Err(solver::SolverError::Invalid { field, reason }) => {
+                    assert_eq!(field, "material.hardness", "{reason}");
+                    assert!(reason.contains("P/H"), "{reason}");
+                }
+                other => panic!("H = {cap:e}, F/μP = {ratio}: {other:?}"),
+            }
+        }
+        let spec = with_hardness(common::table_1a_fe(n, d, true, ratio), 1.05 * limit);
+        let out = solve_case(&spec, &mut KernelCache::new()).expect("inside the bound");
+        let s = &out.scalars;
+        assert!(s.converged, "F/μP = {ratio}");
+        assert!(s.p_max_pa <= 1.05 * limit * (1.0 + 1e-12), "{}", s.p_max_pa);
+        assert!(s.plastic.unwrap().plastic_area_m2 > 0.0);
+    }
+    // A softer ball caps the contact: its hardness is the one named.
+    let mut spec = with_hardness(common::table_1a_fe(n, d, true, 0.6), 1e9);
+    spec.indenter = Some(
+        solver::Material::isotropic("steel", 210e9, 0.3)
+            .unwrap()
+            .with_limits(Limits {
+                hardness: Some(1e7),
+                shear_limit: None,
+            })
+            .unwrap(),
+    );
+    match spec.validate() {
+        Err(solver::SolverError::Invalid { field, .. }) => assert_eq!(field, "indenter.hardness"),
+        other => panic!("{other:?}"),
+    }
+}

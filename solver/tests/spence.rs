@@ -423,10 +423,12 @@ fn axisymmetric_reference_gives_spence_stick_ratio() {
 
 /// Solves the F = 0 load history of Table 1(a) Fe at 128² of 2 µm from
 /// `first` to `last` N in `steps` increments with friction `mu`, with the
-/// hull's radii (`solver.radii = "hull"`): c and a are compared with the
-/// edges of the reference's outermost stick and contact annuli. (The second
-/// moments, the default, are exact only where μp − |q| is a Hertz shape on
-/// c, as in Mindlin's problem; Spence's stick zone is not one: at μ = 0.2
+/// default radii (`solver.radii = "moments"`): the zones' own radii
+/// `stick_radius_m` and `contact_radius_m` (their outlines, whatever
+/// `solver.radii` says, issue #59) are compared with the edges of the
+/// reference's outermost stick and contact annuli. (μa's second-moment
+/// radii, `mu_a_*_radius_m`, are exact only where μp − |q| is a Hertz shape
+/// on c, as in Mindlin's problem; Spence's stick zone is not one: at μ = 0.2
 /// their c/a is 0.538 against the edges' 0.68.)
 fn solver_history(
     mu: f64,
@@ -436,7 +438,7 @@ fn solver_history(
     coupling: bool,
 ) -> solver::CaseOutput {
     let mut spec = common::table_1a_fe(128, 2.0, coupling, 0.0);
-    spec.numerics.radii = solver::Radii::Hull;
+    assert_eq!(spec.numerics.radii, solver::Radii::Moments, "the default");
     spec.load.friction = mu;
     spec.load.normal_force_n = last;
     spec.history = Some(LoadHistory {
@@ -455,6 +457,8 @@ fn normal_loading_with_friction_converges_and_matches_the_axisymmetric_solution(
     // Issue #33 item 1: relative to the zero shift, the tangential residual
     // never converged; now every increment does, and the stick ratio equals
     // the axisymmetric reference's for the same load steps within 2 %.
+    // Issue #59: with the default radii, `stick_radius_m / contact_radius_m`
+    // (the zones' own radii) is that ratio; μa's moment radii read less.
     let (first, last, steps) = (0.5, 20.0, 10);
     for &mu in &[0.2, 0.3] {
         let out = solver_history(mu, first, last, steps, true);
@@ -479,6 +483,17 @@ fn normal_loading_with_friction_converges_and_matches_the_axisymmetric_solution(
         assert!(
             ratio < 0.95,
             "μ = {mu}: a slip annulus exists (c/a = {ratio})"
+        );
+        if mu == 0.3 {
+            // The stick edge issue #59 read with the hull's radii pinned
+            // (0.896 a); the moments gave 0.76 a under `stick_radius_m`.
+            assert!((ratio / 0.896 - 1.0).abs() < 0.02, "c/a = {ratio}");
+        }
+        let moments = s.mu_a_stick_radius_m / s.mu_a_contact_radius_m;
+        eprintln!("μ = {mu}: μa's moment radii c/a = {moments}");
+        assert!(
+            moments < expected - 0.05,
+            "μ = {mu}: μa's radii read the stick edge ({moments} against {expected})"
         );
     }
 }

@@ -207,6 +207,59 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     );
 }
 
+/// Issue #59 items 1 and 12: `solve` on a hardness the domain cannot
+/// carry (H = 0.01 GPa, or 1e-300: P/H is hundreds of times the domain's
+/// area) gave `not_converged` and exit 0, or blamed friction under a
+/// tangential load; `hardness_gpa = 1e300` read "got inf Pa". Each is now
+/// an error naming the key, with what was written.
+#[test]
+fn issue59_a_hardness_the_domain_cannot_carry_or_beyond_any_surface_names_its_key() {
+    for h in ["0.01", "1e-300"] {
+        for ratio in ["0.6", "0.0"] {
+            expect_error(
+                SMALL,
+                &[
+                    &format!("materials.Fe.hardness_gpa={h}"),
+                    &format!("load.tangential_ratio={ratio}"),
+                ],
+                "invalid materials.Fe.hardness_gpa: the hardness",
+            );
+        }
+    }
+    expect_error(
+        SMALL,
+        &["materials.Fe.hardness_gpa=1e300"],
+        "materials.Fe.hardness_gpa = 1e300: must be positive",
+    );
+}
+
+/// Issue #59 item 12: `solve` on a case that did not converge wrote
+/// `not_converged` into case.json and said nothing, exit 0. Now stderr says
+/// so and the exit status is 4 (`coordinator::case::EXIT_NOT_ALL_OK`),
+/// the outputs written.
+#[test]
+fn issue59_item12_solve_of_a_case_that_does_not_converge_says_so_and_exits_4() {
+    let tmp_dir = temp_dir("unconverged");
+    let dir = tmp_dir.path().to_path_buf();
+    std::fs::write(dir.join("c.toml"), SMALL).unwrap();
+    let out = run(&[
+        "solve",
+        dir.join("c.toml").to_str().unwrap(),
+        "--set",
+        "solver.max_iterations=2",
+        "--quiet",
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{err}");
+    assert!(err.contains("did not converge"), "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("o/case.json")).unwrap()).unwrap();
+    assert_eq!(json["status"], "not_converged");
+    assert_eq!(json["converged"], false);
+}
+
 #[test]
 fn kernel_prints_h_theta_matching_the_isotropic_closed_form() {
     let out = run(&["kernel", "--material", "Cu", "--angles-deg", "0:90:45"]);

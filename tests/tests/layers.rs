@@ -70,9 +70,9 @@ fn coordinator() -> Layers {
     Layers {
         src: crate_src("coordinator"),
         order: &[
+            ("", "float_text"),
             ("", "case"),
             ("", "convergence"),
-            ("", "float_text"),
             ("", "solve_progress"),
             ("", "scan_file"),
             ("", "config"),

@@ -63,6 +63,9 @@ impl CheckFinite for WireScalars {
         let named = [
             ("contact_radius_m", s.contact_radius_m),
             ("stick_radius_m", s.stick_radius_m),
+            ("mu_a_contact_radius_m", s.mu_a_contact_radius_m),
+            ("mu_a_stick_radius_m", s.mu_a_stick_radius_m),
+            ("pressure_hertz_misfit", s.pressure_hertz_misfit),
             ("delta_t_m", s.delta_t_m),
             ("delta_z_m", s.delta_z_m),
             ("p_max_pa", s.p_max_pa),

@@ -68,14 +68,35 @@ impl MaterialCfg {
         .count()
     }
 
-    /// The plastic limits of the table, in Pa.
-    fn limits(&self) -> solver::Limits {
-        solver::Limits {
+    /// The plastic limits of the table `name`, in Pa, each checked as
+    /// written (GPa): positive and at most [`MAX_LIMIT_GPA`] (#59:
+    /// `hardness_gpa = 1e300` was refused as "got inf Pa").
+    fn limits(&self, name: &str) -> Result<solver::Limits> {
+        for (key, v) in [
+            ("hardness_gpa", self.hardness_gpa),
+            ("shear_limit_gpa", self.shear_limit_gpa),
+        ] {
+            if let Some(v) = v.filter(|&v| !(v > 0.0 && v <= MAX_LIMIT_GPA)) {
+                bail!(
+                    "materials.{name}.{key} = {}: must be positive and at most {MAX_LIMIT_GPA} GPa (no surface is harder than diamond's 100 GPa or so; leave the key out for an elastic surface)",
+                    crate::float_text::fmt_f64(v)
+                );
+            }
+        }
+        Ok(solver::Limits {
             hardness: self.hardness_gpa.map(|v| v * 1e9),
             shear_limit: self.shear_limit_gpa.map(|v| v * 1e9),
-        }
+        })
+    }
+
+    /// Whether the table gives plastic limits.
+    fn has_limits(&self) -> bool {
+        self.hardness_gpa.is_some() || self.shear_limit_gpa.is_some()
     }
 }
+
+/// The largest hardness or shear limit a table may give, GPa.
+pub const MAX_LIMIT_GPA: f64 = 1e4;
 
 /// The key in `[materials.NAME]` of a material parameter.
 pub(super) fn material_key<'a>(param: &'a str, cfg: Option<&MaterialCfg>) -> &'a str {
@@ -157,8 +178,22 @@ impl Config {
             )
         };
         cubic(&o.name, cfg, o.normal, o.x_dir, &explain)?
-            .with_limits(cfg.limits())
+            .with_limits(cfg.limits(&o.base)?)
             .map_err(|e| self.explain(within("material", e), &o.base, ""))
+    }
+
+    /// Every `[materials.NAME]` table resolved, those the sweep does not
+    /// use included (#59: an invalid unused `materials.Zz.hardness_gpa`
+    /// passed `check`); the crystals `sweep.orientations` cuts are checked
+    /// at their orientations instead.
+    pub(super) fn check_material_tables(&self) -> Result<()> {
+        for name in self.materials.keys() {
+            let cut = self.sweep.orientations.is_some() && self.sweep.materials.contains(name);
+            if !cut {
+                self.material_for("materials", name)?;
+            }
+        }
+        Ok(())
     }
 
     /// The name of the sweep's first material (a single case's default):
@@ -243,7 +278,8 @@ impl Config {
     fn material_for(&self, key: &str, name: &str) -> Result<Material> {
         if let Some(m) = self.materials.get(name) {
             let explain = |e| self.explain(within("material", e), name, "");
-            let elastic = if m.elastic_keys() == 0 && m.limits() != solver::Limits::default() {
+            let limits = m.limits(name)?;
+            let elastic = if m.elastic_keys() == 0 && m.has_limits() {
                 // Limits added to a preset.
                 solver::presets::material(name).ok_or_else(|| {
                     anyhow!("materials.{name}: `{name}` is not a preset (see `mpcontact materials`), so its table needs its elastic constants: one of `isotropic`, `stiffness_gpa`, `cubic_gpa`")
@@ -251,7 +287,7 @@ impl Config {
             } else {
                 build_material(name, m, &explain)?
             };
-            return elastic.with_limits(m.limits()).map_err(explain);
+            return elastic.with_limits(limits).map_err(explain);
         }
         solver::presets::material(name).ok_or_else(|| {
             anyhow!("{key}: unknown material `{name}` (not a preset — see `mpcontact materials` — and no [materials.\"{name}\"] table)")
@@ -362,8 +398,11 @@ mod tests {
 
     #[test]
     fn issue50_plastic_limits_add_to_presets_and_tables_or_are_explained() {
-        // On a preset: its constants, with the limits in Pa.
-        let hard = format!("{BASE}\n[materials.Fe]\nhardness_gpa = 1.5\nshear_limit_gpa = 0.2\n");
+        // On a preset: its constants, with the limits in Pa. (Cells of
+        // 5 µm: BASE's 64² of 2 µm cannot hold the contact, and since #59 a
+        // hardness whose P/H does not fit the domain is refused.)
+        let base = BASE.replace("spacing_um = 2.0", "spacing_um = 5.0");
+        let hard = format!("{base}\n[materials.Fe]\nhardness_gpa = 1.5\nshear_limit_gpa = 0.2\n");
         let c = Config::parse(&hard, &[]).unwrap();
         let fe = c.material("Fe").unwrap();
         assert_eq!(fe.limits.hardness, Some(1.5e9));
@@ -374,7 +413,7 @@ mod tests {
         );
         // Beside a table's own constants.
         let own = format!(
-            "{BASE}\n[materials.soft]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nhardness_gpa = 0.5\n"
+            "{base}\n[materials.soft]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nhardness_gpa = 0.5\n"
         )
         .replace("materials = [\"Fe\"]", "materials = [\"soft\"]");
         let c = Config::parse(&own, &[]).unwrap();
@@ -391,6 +430,64 @@ mod tests {
             .replace("materials = [\"Fe\"]", "materials = [\"alloy\"]");
         let e = err(&orphan, &[]);
         assert!(e.contains("not a preset"), "{e}");
+    }
+
+    #[test]
+    fn issue59_item12_a_hardness_beyond_any_surface_is_refused_as_written() {
+        // It was "got inf Pa": 1e300 GPa overflows in Pa.
+        for (v, text) in [("1e300", "1e300"), ("-0.5", "-0.5"), ("nan", "NaN")] {
+            for key in ["hardness_gpa", "shear_limit_gpa"] {
+                let e = err(&format!("{BASE}\n[materials.Fe]\n{key} = {v}\n"), &[]);
+                assert!(
+                    e.contains(&format!("materials.Fe.{key} = {text}:")) && !e.contains("inf"),
+                    "{e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn issue59_item12_an_unused_invalid_material_fails_check() {
+        // The sweep uses Fe only; Zz's table is still read, and refused.
+        for (table, key) in [
+            ("hardness_gpa = -1.0", "materials.Zz.hardness_gpa"),
+            ("hardness_gpa = 1.0", "materials.Zz: `Zz` is not a preset"),
+            (
+                "isotropic = { youngs_gpa = 100.0, poisson = 0.7 }",
+                "materials.Zz.isotropic.poisson",
+            ),
+            (
+                "cubic_gpa = { c11 = 168.4, c12 = 121.4, c44 = 75.4 }",
+                "materials.Zz.normal",
+            ),
+        ] {
+            let e = err(&format!("{BASE}\n[materials.Zz]\n{table}\n"), &[]);
+            assert!(e.contains(key), "{table}: {e}");
+        }
+        let fine = format!(
+            "{BASE}\n[materials.Zz]\nisotropic = {{ youngs_gpa = 100.0, poisson = 0.3 }}\nhardness_gpa = 1.0\n"
+        );
+        Config::parse(&fine, &[]).unwrap();
+    }
+
+    #[test]
+    fn issue59_item1_a_hardness_the_domain_cannot_carry_names_its_key_not_friction() {
+        // BASE: Table 1(a) Fe on 64² of 2 µm under F = 0.6 μP, where
+        // 0.01 GPa gave "gross sliding … Σ μp ΔA" (P/H is 20 times the
+        // domain's area at 5 µm cells, 122 times here).
+        for ratio in ["0.6", "0.0"] {
+            let text = format!("{BASE}\n[materials.Fe]\nhardness_gpa = 0.01\n").replace(
+                "tangential_ratio = 0.6",
+                &format!("tangential_ratio = {ratio}"),
+            );
+            let e = err(&text, &[]);
+            assert!(
+                e.contains("invalid materials.Fe.hardness_gpa")
+                    && e.contains("P/H")
+                    && !e.contains("sliding"),
+                "{e}"
+            );
+        }
     }
 
     #[test]

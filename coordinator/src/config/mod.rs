@@ -229,6 +229,7 @@ impl Config {
             ),
             None => {}
         }
+        self.check_material_tables()?;
         // Whether the workers fit in this machine's memory is checked where
         // they start (`memory::check_fits`), not here.
         for (key, spec) in self.cases()? {

@@ -4,7 +4,7 @@
 //! and, per case, by a sweep; computes nothing the solver did not.
 
 use crate::float_text::fmt_f64;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use plotters::prelude::*;
 use solver::{Grid, HistoryOutput};
 use std::fmt::Write as _;
@@ -177,34 +177,40 @@ impl Figure for Hysteresis<'_> {
 
 /// Writes `history.csv`, `hysteresis.png` and `hysteresis.svg` into `dir`,
 /// and with a wear law the files of [`super::wear::write_wear`].
-/// The table is written first; a picture that cannot be drawn is returned
-/// as a warning, not an error.
+/// The tables are written first; the pictures that could not be drawn are
+/// returned (the caller reports them as lost outputs, an error once the
+/// rest is written). The path's warnings are [`path_warnings`].
 pub fn write_history(
     dir: &Path,
     h: &HistoryOutput,
     grid: &Grid,
     title: &str,
 ) -> Result<Vec<String>> {
-    std::fs::create_dir_all(dir)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     super::atomic::write(&dir.join("history.csv"), history_csv(h).as_bytes())?;
-    let mut warnings = Vec::new();
+    let mut lost = Vec::new();
     for name in ["hysteresis.png", "hysteresis.svg"] {
         if let Err(e) = plot_hysteresis(&dir.join(name), h, title) {
-            warnings.push(format!("{name}: {e:#}"));
+            lost.push(format!("{name}: {e:#}"));
         }
     }
-    warnings.extend(super::wear::write_wear(dir, h, grid, title)?);
-    warnings.extend(
-        super::wear::wear_warnings(h)
-            .into_iter()
-            .chain(history_warnings(h))
-            .map(|w| format!("{title}: {w}")),
-    );
-    Ok(warnings)
+    lost.extend(super::wear::write_wear(dir, h, grid, title)?);
+    Ok(lost)
 }
 
-/// The warnings of a path: auto increments that could not meet their
-/// tolerance.
+/// Every warning of a path, each prefixed by the case's title: the wear's
+/// ([`super::wear::wear_warnings`]) and the increments'
+/// ([`history_warnings`]).
+pub fn path_warnings(h: &HistoryOutput, title: &str) -> Vec<String> {
+    super::wear::wear_warnings(h)
+        .into_iter()
+        .chain(history_warnings(h))
+        .map(|w| format!("{title}: {w}"))
+        .collect()
+}
+
+/// The warnings of a path's increments: auto increments that could not
+/// meet their tolerance.
 pub fn history_warnings(h: &HistoryOutput) -> Vec<String> {
     let mut warnings = Vec::new();
     if h.auto_tolerance_met == Some(false) {

@@ -22,10 +22,17 @@ use crate::float_text::{fmt_f64, fmt_opt as opt};
 
 /// Header of `results.csv` (one row per case, see README.md). Users' tools
 /// read these names: change one only with a reason in the docs.
-pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker,level,grid_points,spacing_m,mu_a_cells,k_e_cells,contact_radius_cells_m,stick_radius_cells_m";
-/// Header of `curves.csv`.
+/// Since issue #59 `contact_radius_m` and `stick_radius_m` are the zones'
+/// own radii (their outlines) and μa's apparent radii are
+/// `mu_a_contact_radius_m`, `mu_a_stick_radius_m` (docs/config.md,
+/// "Renamed in round 5"); `pressure_hertz_misfit` says how far the
+/// pressure is from Hertz's and `mu_a_non_hertz` flags μa beyond
+/// [`solver::HERTZ_MISFIT_LIMIT`].
+pub const RESULTS_HEADER: &str = "material,surface,angle_deg,status,mu_a,k_e,contact_radius_m,stick_radius_m,delta_t_m,delta_z_m,p_max_pa,contact_area_m2,stick_area_m2,normal_iterations,tangential_iterations,coupling_iterations,seconds,worker,level,grid_points,spacing_m,mu_a_cells,k_e_cells,contact_radius_cells_m,stick_radius_cells_m,mu_a_contact_radius_m,mu_a_stick_radius_m,pressure_hertz_misfit,mu_a_non_hertz";
+/// Header of `curves.csv` (`pressure_hertz_misfit` and `mu_a_non_hertz`
+/// of the finest level's case).
 pub const CURVES_HEADER: &str =
-    "material,surface,angle_deg,mu_a,mu_a_err,k_e,k_e_err,method,order,mu_a_by_level,mu_a_cells";
+    "material,surface,angle_deg,mu_a,mu_a_err,k_e,k_e_err,method,order,mu_a_by_level,mu_a_cells,pressure_hertz_misfit,mu_a_non_hertz";
 /// Columns `results.csv` gains when the sweep computes stresses below the
 /// surface (`[stress]`): over the states of a case, the largest von Mises
 /// stress (Pa, over p_H, and its point), the largest Tresca and principal
@@ -209,7 +216,7 @@ pub fn results_csv(rows: &[Row]) -> String {
         let i = |g: fn(&CaseScalars) -> usize| s.map(|s| g(s).to_string()).unwrap_or_default();
         let _ = write!(
             out,
-            "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{}",
+            "{}{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
             identity_cells(r.key, axes),
             fmt_f64(r.spec.load.angle_deg),
             r.status,
@@ -234,6 +241,10 @@ pub fn results_csv(rows: &[Row]) -> String {
             f(|s| s.k_e_cells),
             f(|s| s.contact_radius_cells_m),
             f(|s| s.stick_radius_cells_m),
+            f(|s| s.mu_a_contact_radius_m),
+            f(|s| s.mu_a_stick_radius_m),
+            f(|s| s.pressure_hertz_misfit),
+            flag(s.and_then(CaseScalars::mu_a_non_hertz)),
         );
         if plastic {
             out.push(',');
@@ -246,6 +257,11 @@ pub fn results_csv(rows: &[Row]) -> String {
         out.push('\n');
     }
     out
+}
+
+/// The text of a flag: `true`, `false`, empty when there is none.
+fn flag(v: Option<bool>) -> String {
+    v.map(|b| b.to_string()).unwrap_or_default()
 }
 
 pub(super) fn csv_field(s: &str) -> String {
@@ -270,6 +286,11 @@ pub struct CurvePoint {
     pub mu_a_by_level: Vec<f64>,
     /// μa with the paper's radii on the finest level.
     pub mu_a_cells: Option<f64>,
+    /// The finest level's `pressure_hertz_misfit`.
+    pub hertz_misfit: f64,
+    /// The finest level's `mu_a_non_hertz`: μa on a pressure further from
+    /// Hertz's than [`solver::HERTZ_MISFIT_LIMIT`].
+    pub non_hertz: bool,
     /// A flat-surface case whose K_E was calibrated on itself (anisotropic
     /// material): its K_E(ψ) is the calibration curve.
     pub flat_calibration: bool,
@@ -287,8 +308,9 @@ pub struct CurvePoint {
 
 /// The curve points of `rows`: each material × surface × angle whose
 /// `levels` cases all solved, converged and have a μa. The second value
-/// counts the points left out because a level did not.
-pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
+/// holds the keys (level 0) of the points left out because a level did
+/// not: the figure marks them.
+pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, Vec<CaseKey>) {
     let mut by_point: BTreeMap<String, (CaseKey, Vec<&Row>)> = BTreeMap::new();
     for r in rows {
         let key = r.key.point();
@@ -298,7 +320,7 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             .1
             .push(r);
     }
-    let (mut points, mut incomplete) = (Vec::new(), 0);
+    let (mut points, mut incomplete) = (Vec::new(), Vec::new());
     for (_, (key, mut rs)) in by_point {
         rs.sort_by_key(|r| r.key.level);
         // (cell size, scalars) of every level that solved and converged.
@@ -308,7 +330,7 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             .filter_map(|r| Some((r.spec.grid.dx, r.scalars.as_ref()?)))
             .collect();
         if solved.len() != levels {
-            incomplete += 1;
+            incomplete.push(key);
             continue;
         }
         // No tangential load, no μa: not a curve point, and nothing missing.
@@ -337,6 +359,8 @@ pub fn curve_points(rows: &[Row], levels: usize) -> (Vec<CurvePoint>, usize) {
             k_e,
             mu_a_by_level,
             mu_a_cells: finest.mu_a_cells,
+            hertz_misfit: finest.pressure_hertz_misfit,
+            non_hertz: finest.mu_a_non_hertz() == Some(true),
             flat_calibration: rs[0].spec.surface == solver::Surface::Flat
                 && finest.k_e_source == solver::K_E_FLAT_CALIBRATED,
             dissipated,
@@ -393,7 +417,7 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
         let by_level: Vec<String> = p.mu_a_by_level.iter().map(|&v| fmt_f64(v)).collect();
         let _ = write!(
             out,
-            "{}{},{},{},{},{},{},{},{},{}",
+            "{}{},{},{},{},{},{},{},{},{},{},{}",
             identity_cells(&p.key, axes),
             fmt_f64(p.key.angle_deg),
             fmt_f64(p.mu_a.value),
@@ -404,6 +428,8 @@ pub fn curves_csv(points: &[CurvePoint]) -> String {
             opt(p.mu_a.order),
             by_level.join(";"),
             opt(p.mu_a_cells),
+            fmt_f64(p.hertz_misfit),
+            p.non_hertz,
         );
         if history {
             let _ = write!(
@@ -476,23 +502,30 @@ pub struct CurveSummary {
 /// summary.json (`flat`, or `flat @ steel` in a sweep over balls).
 type CurveId<'a> = (&'a str, String);
 
+/// The name of `key`'s curve in the figure's legend and summary.json: the
+/// surface, with the ball, load and amplitude of the sweep's axes
+/// (`flat @ steel @ 6000 N`).
+fn curve_label(key: &CaseKey) -> String {
+    let mut surface = match &key.indenter {
+        Some(ball) => format!("{} @ {ball}", key.surface),
+        None => key.surface.clone(),
+    };
+    if let Some(n) = key.normal_n {
+        surface.push_str(&format!(" @ {} N", fmt_f64(n)));
+    }
+    if let Some(a) = key.amplitude_um {
+        surface.push_str(&format!(" @ {} µm", fmt_f64(a)));
+    }
+    surface
+}
+
 /// The curve points of each material × surface (× ball), keyed by
 /// (material, surface label), sorted by angle: the one grouping behind
 /// `summary.json`'s curves and the figure.
 fn by_curve(points: &[CurvePoint]) -> BTreeMap<CurveId<'_>, Vec<&CurvePoint>> {
     let mut m: BTreeMap<CurveId<'_>, Vec<&CurvePoint>> = BTreeMap::new();
     for p in points {
-        let mut surface = match &p.key.indenter {
-            Some(ball) => format!("{} @ {ball}", p.key.surface),
-            None => p.key.surface.clone(),
-        };
-        if let Some(n) = p.key.normal_n {
-            surface.push_str(&format!(" @ {n} N"));
-        }
-        if let Some(a) = p.key.amplitude_um {
-            surface.push_str(&format!(" @ {a} µm"));
-        }
-        m.entry((p.key.material.as_str(), surface))
+        m.entry((p.key.material.as_str(), curve_label(&p.key)))
             .or_default()
             .push(p);
     }
@@ -559,11 +592,17 @@ pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> 
     out
 }
 
-/// One panel of the sweep's figure: named series of (angle, value, error).
+/// One panel of the sweep's figure: named series of (angle, value, error);
+/// the points whose μa is flagged (`mu_a_non_hertz`), ringed; and per
+/// series the angles without a result (failed or not converged), crossed
+/// on the panel's floor.
+#[derive(Default)]
 struct Panel {
     title: String,
     y_desc: &'static str,
     series: BTreeMap<String, Vec<(f64, f64, Option<f64>)>>,
+    flagged: Vec<(String, f64, f64)>,
+    missing: BTreeMap<String, Vec<f64>>,
 }
 
 /// One panel per material, titled "material: `what`", of `value` (y and
@@ -590,7 +629,7 @@ fn panels_of(
                 .or_insert_with(|| Panel {
                     title: format!("{material}: {what}"),
                     y_desc,
-                    series: BTreeMap::new(),
+                    ..Default::default()
                 })
                 .series
                 .insert(surface, series);
@@ -606,23 +645,34 @@ fn panels_of(
 /// K_E(ψ) (GPa) for those materials; on a surface with a hardness, a panel
 /// per material of the area at the hardness (mm²); with `[stress]`, a panel
 /// per material of the largest von Mises stress over p_H. The legend sits
-/// beside the panels.
-pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
+/// beside the panels. A μa on a pressure that is not Hertz's
+/// (`mu_a_non_hertz`) is ringed; the `missing` points (failed or not
+/// converged, [`curve_points`]) are crossed on the floor of their
+/// material's μa panel, so that a curve without them says so (#59).
+pub fn plot_curves(path: &Path, points: &[CurvePoint], missing: &[CaseKey]) -> anyhow::Result<()> {
     let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
     let mut k_e = Panel {
         title: "K_E(ψ), flat-surface calibration".into(),
         y_desc: "K_E (GPa)",
-        series: BTreeMap::new(),
+        ..Default::default()
+    };
+    let mu_a_panel = |material: &str| Panel {
+        title: material.to_string(),
+        y_desc: "apparent friction μa (–)",
+        ..Default::default()
     };
     for ((material, surface), pts) in by_curve(points) {
-        let panel = by_material.entry(material).or_insert_with(|| Panel {
-            title: material.to_string(),
-            y_desc: "apparent friction μa (–)",
-            series: BTreeMap::new(),
-        });
+        let panel = by_material
+            .entry(material)
+            .or_insert_with(|| mu_a_panel(material));
         let mu = pts
             .iter()
             .map(|p| (p.key.angle_deg, p.mu_a.value, p.mu_a.err));
+        panel.flagged.extend(
+            pts.iter()
+                .filter(|p| p.non_hertz)
+                .map(|p| (surface.clone(), p.key.angle_deg, p.mu_a.value)),
+        );
         panel.series.insert(surface, mu.collect());
         if pts.iter().all(|p| p.flat_calibration) {
             let gpa = |v: f64| v / 1e9;
@@ -668,6 +718,14 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint]) -> anyhow::Result<()> {
     let plastic = panels_of(points, "area at the hardness", "plastic area (mm²)", |p| {
         Some((p.plastic?.plastic_area_m2 * 1e6, None))
     });
+    for key in missing {
+        let panel = by_material
+            .entry(key.material.as_str())
+            .or_insert_with(|| mu_a_panel(&key.material));
+        let label = curve_label(key);
+        panel.series.entry(label.clone()).or_default();
+        panel.missing.entry(label).or_default().push(key.angle_deg);
+    }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
     panels.extend(energy);
     panels.extend(worn);
@@ -725,8 +783,15 @@ impl Figure for Curves {
                 xlo = xlo.min(x);
                 xhi = xhi.max(x);
             }
+            for &x in panel.missing.values().flatten() {
+                xlo = xlo.min(x);
+                xhi = xhi.max(x);
+            }
             if !lo.is_finite() {
-                (lo, hi, xlo, xhi) = (0.0, 1.0, 0.0, 180.0);
+                (lo, hi) = (0.0, 1.0);
+            }
+            if !xlo.is_finite() {
+                (xlo, xhi) = (0.0, 180.0);
             }
             let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1.0));
             if xhi <= xlo {
@@ -742,7 +807,9 @@ impl Figure for Curves {
                 area,
                 &panel.title,
                 (xlo - xpad)..(xhi + xpad),
-                (lo - pad)..(hi + pad),
+                // Room below the data for a row of crosses per curve with
+                // angles missing, so that one never hides another.
+                (lo - pad * (1.0 + 0.6 * panel.missing.len().saturating_sub(1) as f64))..(hi + pad),
             )?;
             chart
                 .configure_mesh()
@@ -787,6 +854,28 @@ impl Figure for Curves {
                     }))
                     .map_err(err)?;
             }
+            // Flagged μa ringed; angles without a result crossed on the floor.
+            for (name, x, y) in &panel.flagged {
+                let (color, _) = style_of(name);
+                chart
+                    .draw_series(std::iter::once(Circle::new(
+                        (*x, *y),
+                        9,
+                        color.stroke_width(2),
+                    )))
+                    .map_err(err)?;
+            }
+            for (k, (name, angles)) in panel.missing.iter().enumerate() {
+                let (color, _) = style_of(name);
+                let floor = lo - pad * (0.5 + 0.6 * k as f64);
+                chart
+                    .draw_series(
+                        angles
+                            .iter()
+                            .map(|&x| Cross::new((x, floor), 7, color.stroke_width(3))),
+                    )
+                    .map_err(err)?;
+            }
         }
         // The legend beside the panels, never over the data.
         for (k, name) in names.iter().enumerate() {
@@ -812,6 +901,37 @@ impl Figure for Curves {
                     ("sans-serif", 16),
                 ))
                 .map_err(err)?;
+        }
+        // What the rings and the floor's crosses mean, under the legend.
+        let mut y = 30 + 24 * names.len() as i32 + 12;
+        let grey = BLACK.mix(0.7);
+        let note = |y: i32, lines: &[&str]| -> anyhow::Result<()> {
+            for (k, line) in lines.iter().enumerate() {
+                legend_area
+                    .draw(&Text::new(
+                        line.to_string(),
+                        (48, y - 8 + 16 * k as i32),
+                        ("sans-serif", 14),
+                    ))
+                    .map_err(err)?;
+            }
+            Ok(())
+        };
+        if panels.iter().any(|p| !p.flagged.is_empty()) {
+            legend_area
+                .draw(&Circle::new((25, y), 9, grey.stroke_width(2)))
+                .map_err(err)?;
+            note(y, &["μa flagged: pressure", "not Hertz's (README)"])?;
+            y += 40;
+        }
+        if panels.iter().any(|p| !p.missing.is_empty()) {
+            legend_area
+                .draw(&Cross::new((25, y), 7, grey.stroke_width(3)))
+                .map_err(err)?;
+            note(
+                y,
+                &["no result at this", "angle (failed or", "not converged)"],
+            )?;
         }
         Ok(())
     }

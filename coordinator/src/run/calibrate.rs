@@ -96,8 +96,8 @@ mod tests {
             seconds: 1.0,
             kernel_builds: 1,
             scalars: Some(CaseScalars {
-                contact_radius_m: a,
-                stick_radius_m: c,
+                mu_a_contact_radius_m: a,
+                mu_a_stick_radius_m: c,
                 delta_t_m: dt,
                 mu_a: Some(0.0),
                 k_e: 1.0,

@@ -84,6 +84,22 @@ impl Entry {
 /// How every journal's first line (its header) begins.
 const HEADER_START: &str = "{\"kind\":\"header\"";
 
+/// The first protocol whose results hold the zones' own radii apart from
+/// μa's (issue #59): the journals of earlier ones do not resume.
+const RADII_SPLIT_VERSION: u32 = 7;
+
+/// Refuses a journal at `path` written with `protocol_version` when its
+/// results cannot be read as this build's.
+fn check_version(path: &Path, protocol_version: u32) -> anyhow::Result<()> {
+    if protocol_version < RADII_SPLIT_VERSION {
+        bail!(
+            "{} was written by an earlier build (protocol {protocol_version}), whose contact_radius_m and stick_radius_m were μa's apparent radii (now mu_a_contact_radius_m, mu_a_stick_radius_m; issue #59); run the sweep again into another --out",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// A journal line.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -182,8 +198,9 @@ impl Journal {
                     Some(Line::Header {
                         run_id: old,
                         config: old_cfg,
-                        ..
+                        protocol_version,
                     }) if first => {
+                        check_version(&path, protocol_version).context("--resume refused")?;
                         if old_cfg != config {
                             bail!(
                                 "--resume refused: {} was written for a different config ({})",
@@ -277,8 +294,12 @@ impl Journal {
         let f = File::open(path)?;
         let mut out = Vec::new();
         for line in BufReader::new(f).lines() {
-            if let Ok(Line::Case(r)) = serde_json::from_str::<Line>(&line?) {
-                out.push(*r);
+            match serde_json::from_str::<Line>(&line?) {
+                Ok(Line::Case(r)) => out.push(*r),
+                Ok(Line::Header {
+                    protocol_version, ..
+                }) => check_version(path, protocol_version)?,
+                Err(_) => {}
             }
         }
         Ok(out)

@@ -42,6 +42,7 @@ pub use summary::{IpcStats, RunSummary, WorkerSummary};
 pub use supervise::WorkerCommand;
 
 use crate::config::Config;
+use crate::float_text::fmt_f64;
 use crate::output::{atomic, fretting_map, history, orientation_map, sweep};
 
 /// Everything `mpcontact run` passes to the runner.
@@ -205,6 +206,12 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
             eprintln!("  failed {id}: {why}");
         }
     }
+    for w in &summary.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(line) = summary.without_result() {
+        eprintln!("error: {line}");
+    }
     Ok(summary)
 }
 
@@ -247,6 +254,8 @@ fn write_outputs(
     orientations: &[crate::config::Orientation],
 ) -> anyhow::Result<()> {
     let rows = calibrate::calibrate(cases, outcomes);
+    // Outputs that could not be written; summary.json lists them too.
+    let mut lost: Vec<String> = Vec::new();
     let write = |name: &str, text: String| atomic::write(&dir.join(name), text.as_bytes());
     write("results.csv", sweep::results_csv(&rows))?;
     let levels = cases.iter().map(|c| c.key.level + 1).max().unwrap_or(1);
@@ -259,10 +268,13 @@ fn write_outputs(
         .unwrap_or_default()
         .definition();
     summary.apparent_radius_definition_cells = solver::APPARENT_RADIUS_DEFINITION_CELLS;
+    summary.zone_radius_definition = solver::ZONE_RADIUS_DEFINITION;
+    summary.hertz_misfit_definition = solver::HERTZ_MISFIT_DEFINITION;
+    summary.hertz_misfit_limit = solver::HERTZ_MISFIT_LIMIT;
     summary.k_e_definition = solver::K_E_DEFINITION;
     summary.error_estimate = crate::convergence::ERROR_ESTIMATE;
     summary.convergence_levels = levels;
-    summary.incomplete_points = incomplete;
+    summary.incomplete_points = incomplete.len();
     summary.curves = sweep::curve_summaries(&points);
     summary.sampling = cases
         .iter()
@@ -286,16 +298,18 @@ fn write_outputs(
             title.push_str(&format!(", {ball} ball"));
         }
         if let Some(n) = key.normal_n {
-            title.push_str(&format!(", P = {n} N"));
+            title.push_str(&format!(", P = {} N", fmt_f64(n)));
         }
         if let Some(a) = key.amplitude_um {
-            title.push_str(&format!(", Δ = {a} µm"));
+            title.push_str(&format!(", Δ = {} µm", fmt_f64(a)));
         }
-        match history::write_history(&sweep::fields_dir(dir, key), h, &r.spec.grid, &title) {
-            Ok(warnings) => summary.output_warnings.extend(warnings),
-            Err(e) => summary
-                .output_warnings
-                .push(format!("history of {key}: {e:#}")),
+        summary
+            .output_warnings
+            .extend(history::path_warnings(h, &title));
+        let fields = sweep::fields_dir(dir, key);
+        match history::write_history(&fields, h, &r.spec.grid, &title) {
+            Ok(figures) => lost.extend(figures.into_iter().map(|f| format!("{key}: {f}"))),
+            Err(e) => lost.push(format!("history of {key}: {e:#}")),
         }
     }
     // With [stress]: each case's stress scalars beside its fields, the
@@ -320,7 +334,7 @@ fn write_outputs(
         )?;
         for name in ["fretting_map.png", "fretting_map.svg"] {
             if let Err(e) = fretting_map::plot_map(&dir.join(name), &map) {
-                summary.output_warnings.push(format!("{name}: {e:#}"));
+                lost.push(format!("{name}: {e:#}"));
             }
         }
     }
@@ -333,17 +347,16 @@ fn write_outputs(
         )?;
         for map in orientation_map::ipf_maps(&table) {
             if let Err(e) = orientation_map::write_ipf(&dir.join("ipf"), &map) {
-                summary
-                    .output_warnings
-                    .push(format!("ipf/{}: {e:#}", map.path.display()));
+                lost.push(format!("ipf/{}: {e:#}", map.path.display()));
             }
         }
     }
     for name in ["mu_a_vs_angle.png", "mu_a_vs_angle.svg"] {
-        if let Err(e) = sweep::plot_curves(&dir.join(name), &points) {
-            summary.output_warnings.push(format!("{name}: {e:#}"));
+        if let Err(e) = sweep::plot_curves(&dir.join(name), &points, &incomplete) {
+            lost.push(format!("{name}: {e:#}"));
         }
     }
+    summary.output_warnings.extend(lost.iter().cloned());
     #[derive(Serialize)]
     struct SummaryFile<'a> {
         #[serde(flatten)]
@@ -357,5 +370,16 @@ fn write_outputs(
         protocol_version: protocol::PROTOCOL_VERSION,
     })?;
     write("summary.json", text + "\n")?;
+    // An output that could not be written is an error (#59: a history lost
+    // to a file name too long was only a line in summary.json), said after
+    // everything else was written.
+    if !lost.is_empty() {
+        anyhow::bail!(
+            "{} output(s) of {} could not be written (the others were):\n  {}",
+            lost.len(),
+            dir.display(),
+            lost.join("\n  ")
+        );
+    }
     Ok(())
 }

@@ -133,10 +133,24 @@ pub struct RunSummary {
     pub ipc: Vec<IpcStats>,
     /// Messages rejected by validation (logged).
     pub rejected_messages: usize,
-    /// Output files that could not be written (plots need fonts).
+    /// Output files that could not be written (the run then ends with an
+    /// error naming them), and the warnings of worn paths.
     pub output_warnings: Vec<String>,
-    /// Definition of the apparent radii a, c used in μa (`mu_a`, `k_e`).
+    /// Physics the run warns of, printed on the console too: per material,
+    /// cases whose peak pressure exceeds its typical hardness as a preset
+    /// with no `hardness_gpa` to cap it. Left out when there is none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// Definition of the zones' own radii (`contact_radius_m`, `stick_radius_m`).
+    pub zone_radius_definition: &'static str,
+    /// Definition of the apparent radii a, c used in μa (`mu_a`, `k_e`,
+    /// `mu_a_contact_radius_m`, `mu_a_stick_radius_m`).
     pub apparent_radius_definition: &'static str,
+    /// Definition of `pressure_hertz_misfit`, and the limit beyond which μa
+    /// is flagged (`mu_a_non_hertz`).
+    pub hertz_misfit_definition: &'static str,
+    /// See `hertz_misfit_definition`.
+    pub hertz_misfit_limit: f64,
     /// Definition of the paper's radii (`mu_a_cells`, `k_e_cells`).
     pub apparent_radius_definition_cells: &'static str,
     /// Grids per case (1: no convergence ladder).
@@ -156,6 +170,23 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
+    /// What the console says when some cases have no result (failed or
+    /// not converged), `None` when every case is ok: the run then exits
+    /// with [`crate::case::EXIT_NOT_ALL_OK`] (#59: all seven circle-A cases
+    /// of Table 1(c) at H = 0.9 GPa failed, and the run said "ok").
+    pub fn without_result(&self) -> Option<String> {
+        let missing = self.failed + self.not_converged;
+        (missing > 0).then(|| {
+            format!(
+                "{missing} of {} cases have no result ({} failed, {} not converged): their points are left out of curves.csv and crossed on the floor of mu_a_vs_angle.png/.svg (exit status {})",
+                self.total,
+                self.failed,
+                self.not_converged,
+                crate::case::EXIT_NOT_ALL_OK
+            )
+        })
+    }
+
     /// The kernel counts of the whole run, from `per_worker`.
     pub fn count_kernels(&mut self) {
         let workers = self.per_worker.values();
@@ -169,10 +200,25 @@ impl RunSummary {
     }
 
     /// Count the recorded cases by status; list failures and non-converged
-    /// cases by their display text.
+    /// cases by their display text; warn once per material of the cases
+    /// that press it beyond its typical hardness.
     pub fn tally(&mut self, cases: &[PlannedCase], outcomes: &[Option<Outcome>]) {
+        // Material → (cases, the largest p_max and its case, the range).
+        let mut beyond: BTreeMap<String, (usize, f64, String, solver::presets::HardnessRange)> =
+            BTreeMap::new();
         for (case, outcome) in cases.iter().zip(outcomes) {
             let Some(r) = outcome else { continue };
+            if let Some(s) = &r.scalars {
+                if let Some((m, range)) = case.spec.pressure_beyond_hardness(s.p_max_pa) {
+                    let e = beyond
+                        .entry(m.name.clone())
+                        .or_insert((0, 0.0, String::new(), range));
+                    e.0 += 1;
+                    if s.p_max_pa > e.1 {
+                        (e.1, e.2) = (s.p_max_pa, case.key.to_string());
+                    }
+                }
+            }
             match r.status {
                 Status::Ok => self.ok += 1,
                 Status::NotConverged => {
@@ -187,6 +233,20 @@ impl RunSummary {
                     );
                 }
             }
+        }
+        let solved = outcomes
+            .iter()
+            .flatten()
+            .filter(|o| o.scalars.is_some())
+            .count();
+        for (name, (count, p_max, at, range)) in beyond {
+            self.warnings.push(format!(
+                "{count} of {solved} solved cases press {name} beyond its typical hardness ({:.1}–{:.1} GPa, {}): p_max up to {:.2} GPa ({at}); a real surface yields there — set [materials.{name}] hardness_gpa to cap the pressure",
+                range.low_pa / 1e9,
+                range.high_pa / 1e9,
+                range.what,
+                p_max / 1e9
+            ));
         }
     }
 }

@@ -34,9 +34,43 @@ pub fn hull_area(grid: &Grid, mask: &[bool]) -> f64 {
 /// the zone with a small weight moves it by that weight's share. Zero for a
 /// zero weight.
 pub fn moment_radius(grid: &Grid, mask: &[bool], level: &[f64]) -> f64 {
-    let n = grid.n;
     let weight = |i: usize| if mask[i] { level[i] } else { 0.0 };
-    // Sums row by row in a fixed order (results do not depend on threads).
+    let Some((w, cx, cy)) = centroid(grid, &weight) else {
+        return 0.0;
+    };
+    let mut wr2 = 0.0;
+    about(grid, &weight, (cx, cy), |v, dx, dy| {
+        wr2 += v * (dx * dx + dy * dy)
+    });
+    (2.5 * wr2 / w).sqrt()
+}
+
+/// Calls `f(w, dx, dy)` for every cell of positive weight `w = weight(i)`,
+/// `(dx, dy)` its centre's offset from `(cx, cy)`, row by row in a fixed
+/// order (the sums it makes do not depend on threads).
+fn about(
+    grid: &Grid,
+    weight: &dyn Fn(usize) -> f64,
+    (cx, cy): (f64, f64),
+    mut f: impl FnMut(f64, f64, f64),
+) {
+    let n = grid.n;
+    for iy in 0..n {
+        let dy = grid.y(iy) - cy;
+        for ix in 0..n {
+            let v = weight(iy * n + ix);
+            if v > 0.0 {
+                f(v, grid.x(ix) - cx, dy);
+            }
+        }
+    }
+}
+
+/// The total of the positive weights `weight(i)` over the grid's cells and
+/// their centroid `(Σw, x̄, ȳ)`; `None` for a zero total. Sums row by row
+/// in a fixed order (results do not depend on threads).
+fn centroid(grid: &Grid, weight: &dyn Fn(usize) -> f64) -> Option<(f64, f64, f64)> {
+    let n = grid.n;
     let (mut w, mut wx, mut wy) = (0.0, 0.0, 0.0);
     for iy in 0..n {
         let y = grid.y(iy);
@@ -49,22 +83,37 @@ pub fn moment_radius(grid: &Grid, mask: &[bool], level: &[f64]) -> f64 {
             }
         }
     }
-    if w <= 0.0 {
-        return 0.0;
-    }
-    let (cx, cy) = (wx / w, wy / w);
-    let mut wr2 = 0.0;
-    for iy in 0..n {
-        let dy = grid.y(iy) - cy;
-        for ix in 0..n {
-            let v = weight(iy * n + ix);
-            if v > 0.0 {
-                let dx = grid.x(ix) - cx;
-                wr2 += v * (dx * dx + dy * dy);
-            }
-        }
-    }
-    (2.5 * wr2 / w).sqrt()
+    (w > 0.0).then(|| (w, wx / w, wy / w))
+}
+
+/// The spread of a weight over a zone about its own centroid: the
+/// weighted means of `(x − x̄)²`, `(x − x̄)(y − ȳ)`, `(y − ȳ)²` (the second
+/// moment tensor) and of `r⁴ = ((x − x̄)² + (y − ȳ)²)²`, m² and m⁴.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadialMoments {
+    /// `⟨(x − x̄)²⟩`, `⟨(x − x̄)(y − ȳ)⟩`, `⟨(y − ȳ)²⟩`, m².
+    pub second: [f64; 3],
+    /// `⟨r⁴⟩`, m⁴.
+    pub fourth: f64,
+}
+
+/// [`RadialMoments`] of the weight `level` over the zone `mask` (cells
+/// outside it, or of level ≤ 0, weigh nothing); `None` for a zero weight.
+pub fn radial_moments(grid: &Grid, mask: &[bool], level: &[f64]) -> Option<RadialMoments> {
+    let weight = |i: usize| if mask[i] { level[i] } else { 0.0 };
+    let (w, cx, cy) = centroid(grid, &weight)?;
+    let (mut xx, mut xy, mut yy, mut r4) = (0.0, 0.0, 0.0, 0.0);
+    about(grid, &weight, (cx, cy), |v, dx, dy| {
+        let r2 = dx * dx + dy * dy;
+        xx += v * dx * dx;
+        xy += v * dx * dy;
+        yy += v * dy * dy;
+        r4 += v * r2 * r2;
+    });
+    Some(RadialMoments {
+        second: [xx / w, xy / w, yy / w],
+        fourth: r4 / w,
+    })
 }
 
 /// Area (m²) of the convex hull of the boundary of `mask` located to

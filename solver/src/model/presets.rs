@@ -65,6 +65,53 @@ pub fn material_source(name: &str) -> &'static str {
     }
 }
 
+/// A preset material's typical hardness: the range a real surface of it
+/// has (Vickers HV × 9.81 MPa; Tabor's H ≈ 3Y), and what spans it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HardnessRange {
+    /// Softest typical hardness, Pa.
+    pub low_pa: f64,
+    /// Hardest typical hardness, Pa: a pressure above it yields a real surface.
+    pub high_pa: f64,
+    /// What the range spans.
+    pub what: &'static str,
+}
+
+/// The typical hardness of the preset `name` (docs/config.md,
+/// `materials.NAME.hardness_gpa`); `None` for a name that is no preset.
+pub fn hardness_range(name: &str) -> Option<HardnessRange> {
+    let (low, high, what) = match name {
+        "Fe" => (0.7, 1.8, "annealed pure iron to mild steel"),
+        "Cu" => (0.4, 1.2, "annealed to cold-worked copper"),
+        "Ni" => (0.8, 1.2, "annealed nickel"),
+        "Fe(111)" | "Cu(111)" | "Ni(111)" => (
+            0.5,
+            1.5,
+            "single crystals by nanoindentation at micrometre depths",
+        ),
+        "steel" => (6.0, 8.0, "hardened bearing steel"),
+        "WC" => (13.0, 18.0, "cemented tungsten carbide"),
+        "Al2O3" => (14.0, 20.0, "sintered alumina"),
+        "glass" => (5.0, 6.0, "soda-lime glass"),
+        _ => return None,
+    };
+    Some(HardnessRange {
+        low_pa: low * GPA,
+        high_pa: high * GPA,
+        what,
+    })
+}
+
+/// The typical hardness of `m` when it is a preset (its name and elastic
+/// constants: a `[materials.Fe]` table with constants of its own is not
+/// the preset and has none).
+pub fn typical_hardness(m: &Material) -> Option<HardnessRange> {
+    let preset = material(&m.name)?;
+    (preset.elasticity == m.elasticity)
+        .then(|| hardness_range(&m.name))
+        .flatten()
+}
+
 /// A preset material by name (case-sensitive, as printed by `mpcontact materials`).
 pub fn material(name: &str) -> Option<Material> {
     materials().into_iter().find(|m| m.name == name)
@@ -117,6 +164,16 @@ mod tests {
             let got = surface(name).unwrap().density();
             assert!((got - d).abs() < 0.0006, "{name}: {got}");
         }
+    }
+
+    #[test]
+    fn every_preset_material_has_a_typical_hardness_and_tables_of_its_own_none() {
+        for m in materials() {
+            let r = typical_hardness(&m).unwrap_or_else(|| panic!("{}", m.name));
+            assert!(0.0 < r.low_pa && r.low_pa < r.high_pa, "{}", m.name);
+        }
+        let own = Material::isotropic("Fe", 100e9, 0.3).unwrap();
+        assert_eq!(typical_hardness(&own), None);
     }
 
     #[test]

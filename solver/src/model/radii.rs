@@ -1,7 +1,9 @@
-//! What the model means by an apparent radius: the definitions μa and K_E
-//! can use (`Radii`, with the text outputs state), and the radius of a zone
-//! read from its level field under each. The solvers' load histories and the
-//! results both apply them, so they live below both.
+//! What the model means by a zone's radius: the zone's own (its outline,
+//! `contact_radius_m` and `stick_radius_m` in every output), the apparent
+//! radii μa and K_E can use (`Radii`, `mu_a_*_radius_m`, with the texts
+//! outputs state), and the radius of a zone read from its level field under
+//! each. The solvers' load histories and the results both apply them, so
+//! they live below both.
 
 use serde::{Deserialize, Serialize};
 
@@ -42,13 +44,23 @@ impl Radii {
     }
 }
 
-/// How the apparent radii a and c (`contact_radius_m`, `stick_radius_m`,
-/// used for `mu_a` and `k_e`) are defined under `solver.radii = "hull"`.
+/// How the apparent radii a and c (`mu_a_contact_radius_m`,
+/// `mu_a_stick_radius_m`, used for `mu_a` and `k_e`) are defined under
+/// `solver.radii = "hull"`; also the zones' own radii
+/// ([`ZONE_RADIUS_DEFINITION`]).
 pub const APPARENT_RADIUS_DEFINITION: &str = "radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres: along every row and column, the zero of p^2 ((mu p - |q|)^2 for stick) extrapolated linearly outward from the two outermost cells, kept within one cell pitch (the cell face where the level does not fall outward)";
 
 /// The second-moment definition of the apparent radii (`solver.radii =
 /// "moments"`, the default; the paper's is [`APPARENT_RADIUS_DEFINITION`]).
 pub const APPARENT_RADIUS_DEFINITION_MOMENTS: &str = "radius from the second moment about the centroid, r^2 = 5/2 <r^2>, of the pressure over the contact cells (of mu p - |q| over the stick cells): exact for a Hertz pressure and a Cattaneo-Mindlin stick zone, continuous in the solution";
+
+/// How the zones' own radii (`contact_radius_m`, `stick_radius_m`: the
+/// contact and the stick zone under every load, whatever `solver.radii`
+/// says) are defined: their outline, the hull of [`APPARENT_RADIUS_DEFINITION`]
+/// (issue #59: the second moments are exact only for Hertz and Mindlin's
+/// stick zone; on Spence's normal loading with friction they read 0.76 a
+/// where the stick zone's edge is at 0.896 a).
+pub const ZONE_RADIUS_DEFINITION: &str = "the zone's outline, under any solver.radii: radius of the circle with the area of the convex hull of the contact (stick) boundary located between cell centres (as solver.radii = \"hull\" defines it)";
 
 /// How the paper's radii (`contact_radius_cells_m`, `stick_radius_cells_m`,
 /// used for `mu_a_cells` and `k_e_cells`) are defined.
@@ -78,6 +90,13 @@ pub(crate) fn apparent_radius(
         )),
         Radii::Moments => moment_radius(grid, mask, level),
     }
+}
+
+/// The zone's own radius (m) of `mask` from its level field
+/// ([`ZONE_RADIUS_DEFINITION`]): its outline, the sub-cell hull, under any
+/// `solver.radii`.
+pub(crate) fn zone_radius(grid: &Grid, mask: &[bool], level: &[f64], terrain: &Terrain) -> f64 {
+    apparent_radius(Radii::Hull, grid, mask, level, terrain)
 }
 
 /// The stick zone's friction reserve `(μp − |q|)⁺` per cell, Pa: the level

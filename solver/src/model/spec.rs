@@ -658,6 +658,27 @@ impl CaseSpec {
         }
     }
 
+    /// On an elastic interface (no hardness set): the body, substrate or
+    /// ball, whose typical hardness as a preset
+    /// ([`crate::presets::typical_hardness`]) the peak pressure `p_max_pa`
+    /// exceeds (of the two, the softer), with that range; `None` when
+    /// neither does, when a hardness caps the pressure, or for materials
+    /// that are no presets (#59: worn flats and island edges reached
+    /// 3.6–16 GPa, which no such surface carries).
+    pub fn pressure_beyond_hardness(
+        &self,
+        p_max_pa: f64,
+    ) -> Option<(&Material, crate::model::presets::HardnessRange)> {
+        if self.limits().hardness.is_some() {
+            return None;
+        }
+        std::iter::once(&self.material)
+            .chain(self.indenter.as_ref())
+            .filter_map(|m| Some((m, crate::model::presets::typical_hardness(m)?)))
+            .filter(|(_, r)| p_max_pa > r.high_pa)
+            .min_by(|a, b| a.1.high_pa.total_cmp(&b.1.high_pa))
+    }
+
     /// The pressure whose μ-multiple bounds the shear traction of each
     /// cell: `p` itself, or with a shear limit τ_c `min(p, τ_c c / μ)`
     /// (`c` the cell's cover, 1 where whole), so that the bound is
@@ -934,6 +955,66 @@ impl CaseSpec {
                 ),
             });
         }
-        Ok(())
+        self.check_hardness_fits()
+    }
+
+    /// A hardness H caps every cell's pressure, so the contact covers at
+    /// least P/H under the largest normal load P of the case: a disc of
+    /// radius √(P/(πH)) on a sphere's axisymmetric gap (flat or a lattice,
+    /// whose contact's outline is wider still), anywhere on a height map.
+    /// When that reaches the outermost ring of cells, which must stay free,
+    /// no solve can carry the load: H = 0.01 GPa on Table 1(a) Fe at 64² of
+    /// 5 µm (P/H twenty times the domain's area) came back `not_converged`
+    /// with p_max = 505 H, and blamed friction under a tangential load
+    /// (#59). The error names the body whose hardness caps the contact.
+    fn check_hardness_fits(&self) -> Result<(), SolverError> {
+        let Some(hardness) = self.limits().hardness else {
+            return Ok(());
+        };
+        let body = if self.material.limits.hardness == Some(hardness) {
+            "material.hardness"
+        } else {
+            "indenter.hardness"
+        };
+        let load = match self
+            .history
+            .as_ref()
+            .and_then(|h| h.normal_forces_n.as_ref())
+        {
+            Some(v) => v.iter().cloned().fold(self.load.normal_force_n, f64::max),
+            None => self.load.normal_force_n,
+        };
+        let grid = &self.grid;
+        let area = load / hardness;
+        // The cells inside the outermost ring.
+        let inner = (grid.n as f64 - 2.0) * grid.dx;
+        let (fits, room) = if matches!(
+            self.surface,
+            crate::model::surface::Surface::Heightmap { .. }
+        ) {
+            (
+                area < inner * inner,
+                format!("the domain's inner cells cover {:.3e} m²", inner * inner),
+            )
+        } else {
+            let radius = (area / std::f64::consts::PI).sqrt();
+            (
+                radius < 0.5 * inner,
+                format!(
+                    "a disc of radius {radius:.3e} m, past the {:.3e} m the domain's inner cells reach from its centre",
+                    0.5 * inner
+                ),
+            )
+        };
+        if fits {
+            return Ok(());
+        }
+        Err(SolverError::invalid(
+            body,
+            format!(
+                "the hardness {:.3e} GPa cannot carry the normal load {load} N inside the domain: the pressure capped at H needs a contact of at least P/H = {area:.3e} m², {room}; raise the hardness (or enlarge grid.points or grid.spacing_um)",
+                hardness / 1e9
+            ),
+        ))
     }
 }

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::base::geometry::covered_area;
 use crate::error::SolverError;
 use crate::model::material::area_at_cap;
-use crate::model::radii::{apparent_radius, friction_reserve};
+use crate::model::radii::{friction_reserve, zone_radius};
 use crate::model::spec::{
     closes_cycle, full_cycles, looked_at_segments, same_point, CaseSpec, Increments, LoadHistory,
     AUTO_LOAD_STEP, AUTO_WEAR_STEP, MAX_HISTORY_STEPS,
@@ -46,7 +46,7 @@ pub struct HistoryStep {
     pub contact_area_m2: f64,
     /// Stick area (contact cells with |q| < μp), m².
     pub stick_area_m2: f64,
-    /// Apparent stick radius (the case's `stick_radius_m` definition, `solver.radii`), m.
+    /// The stick zone's own radius, its outline ([`crate::ZONE_RADIUS_DEFINITION`]), m.
     pub stick_radius_m: f64,
     /// Energy dissipated in this increment ([`DISSIPATION_DEFINITION`]), J.
     pub dissipated_j: f64,
@@ -1101,7 +1101,7 @@ pub(crate) fn solve_history(
             let number = w.cycles.len() + 1;
             let save = number == cycles_total || looked_at.contains(&segment);
             let looped = cycle_rows(&walk.rows, (turning_steps[t - 2], turning_steps[t]), dir);
-            w.record(spec, terrain, &walk.last.p, &looped, save);
+            w.record(terrain, &walk.last.p, &looped, save);
         }
     }
     let Walk {
@@ -1225,7 +1225,7 @@ fn row(spec: &CaseSpec, terrain: &Terrain, state: &ContactState, sums: &StepSums
     let stick_radius = if stick.iter().any(|&b| b) {
         let bound = spec.friction_pressure(p, terrain.cover.as_deref());
         let reserve = friction_reserve(mu, &bound, (&tan.qx, &tan.qy));
-        apparent_radius(spec.numerics.radii, &grid, &stick, &reserve, terrain)
+        zone_radius(&grid, &stick, &reserve, terrain)
     } else {
         0.0
     };

@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::geometry::covered_area;
 use crate::base::grid::Grid;
-use crate::model::radii::apparent_radius;
-use crate::model::spec::{CaseSpec, Wear};
+use crate::model::radii::zone_radius;
+use crate::model::spec::Wear;
 use crate::model::surface::Terrain;
 
 /// The largest depth one simulated cycle may wear, with its jump, as a
@@ -51,9 +51,9 @@ pub struct WearCycle {
     pub scar_area_m2: f64,
     /// Extent of the scar along x and y, m.
     pub scar_extent_m: [f64; 2],
-    /// Apparent contact radius at the cycle's end (`solver.radii`), m.
+    /// The contact zone's own radius at the cycle's end ([`crate::ZONE_RADIUS_DEFINITION`]), m.
     pub contact_radius_m: f64,
-    /// Smallest apparent stick radius over the cycle, m (0 in gross slip).
+    /// Smallest stick zone radius over the cycle (the rows'), m (0 in gross slip).
     pub stick_radius_m: f64,
     /// Force amplitude F* of the cycle, N.
     pub force_amplitude_n: f64,
@@ -282,14 +282,7 @@ impl Wearing {
 
     /// Records the full cycle that ended with pressure `p` (its rows'
     /// reductions `looped`), keeping its profiles if `save`.
-    pub fn record(
-        &mut self,
-        spec: &CaseSpec,
-        terrain: &Terrain,
-        p: &[f64],
-        looped: &CycleRows,
-        save: bool,
-    ) {
+    pub fn record(&mut self, terrain: &Terrain, p: &[f64], looped: &CycleRows, save: bool) {
         let grid = self.grid;
         let n = grid.n;
         let worn = &self.worn;
@@ -370,7 +363,7 @@ impl Wearing {
                 extent(&|i| grid.x(i % n), grid.dx),
                 extent(&|i| grid.y(i / n), grid.dy),
             ],
-            contact_radius_m: apparent_radius(spec.numerics.radii, &grid, &contact, p, terrain),
+            contact_radius_m: zone_radius(&grid, &contact, p, terrain),
             stick_radius_m: if looped.gross {
                 0.0
             } else {
