@@ -1,7 +1,8 @@
 //! What a sweep will do, without doing it: `mpcontact check CONFIG` and
 //! `mpcontact run CONFIG --dry-run`. The expanded sweep, the kernels to
-//! build or found in the cache, and estimates of memory and time. Reads the
-//! config and the kernel cache's headers; writes nothing.
+//! build or found in the cache, estimates of memory and time, and the first
+//! moments of every case (`preflight`: the normal contacts), refused as a
+//! solve would refuse them. Writes nothing.
 
 use anyhow::Result;
 use std::collections::BTreeMap;
@@ -23,8 +24,9 @@ fn human_seconds(s: f64) -> String {
     }
 }
 
-/// The dry-run report of `config` run on `workers` workers; errors exactly as
-/// `run` would give them before starting (config, memory).
+/// The dry-run report of `config` run on `workers` workers; errors exactly
+/// as `run` would give them before starting (config, memory, a case refused
+/// in its first moments).
 pub fn report(config: &Config, workers: usize) -> Result<String> {
     let cases = config.cases()?;
     anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
@@ -58,6 +60,10 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         per_worker,
         workers,
         crate::memory::available_bytes(),
+    )?;
+    let first_moments = crate::preflight::check(
+        cases.iter().map(|(k, s)| (k, s)),
+        crate::preflight::Kernels::ReadOnly,
     )?;
     let mut s = String::new();
     let n0 = config.grid.points;
@@ -160,6 +166,14 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
             (true, false) => "anisotropic, to build (then cached)",
         };
         let _ = writeln!(s, "           {material} at {n}²: {what}");
+    }
+    if let Some((key, reach)) = &first_moments.widest {
+        let _ = writeln!(
+            s,
+            "contacts:  every case's frictionless normal contact solved ({:.1} s), none at the domain's edge; the widest, {key}, reaches {:.0} % of the way from the centre to the outermost cells",
+            first_moments.seconds,
+            100.0 * reach
+        );
     }
     let workers_used = workers.min(cases.len()).max(1);
     let _ = writeln!(

@@ -73,6 +73,7 @@ fn coordinator() -> Layers {
             ("", "config"),
             ("", "memory"),
             ("", "cost"),
+            ("", "preflight"),
             ("output", "atomic"),
             ("output", "npy"),
             ("output", "plot"),
