@@ -14,13 +14,17 @@ use crate::cost::{
 };
 use solver::KernelKey;
 
-fn human_seconds(s: f64) -> String {
-    if s < 90.0 {
-        format!("{s:.0} s")
+/// An estimate of `s` seconds for people ("about 0 s" read as if nothing
+/// would run: below half a second it is "under 1 s").
+fn about_seconds(s: f64) -> String {
+    if s < 0.5 {
+        "under 1 s".into()
+    } else if s < 90.0 {
+        format!("about {s:.0} s")
     } else if s < 5400.0 {
-        format!("{:.1} min", s / 60.0)
+        format!("about {:.1} min", s / 60.0)
     } else {
-        format!("{:.1} h", s / 3600.0)
+        format!("about {:.1} h", s / 3600.0)
     }
 }
 
@@ -212,8 +216,8 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
             .sum::<f64>();
     let _ = writeln!(
         s,
-        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^{CASE_EXPONENT}; a guide within a factor of 2)",
-        human_seconds(total / workers_used as f64),
+        "time:      {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^{CASE_EXPONENT}; a guide within a factor of 2)",
+        about_seconds(total / workers_used as f64),
         solving / cases.len() as f64
     );
     Ok(s)
