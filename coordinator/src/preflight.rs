@@ -69,17 +69,15 @@ pub fn check<'a>(
     // (`solver::normal::solve_normal_from_rest`, the same bits).
     let mut order: Vec<(usize, (&CaseKey, &CaseSpec))> = cases.into_iter().enumerate().collect();
     let total = order.len();
-    order.sort_by(|(_, (a, sa)), (_, (b, sb))| {
-        KernelKey::of(sa)
-            .cmp(&KernelKey::of(sb))
-            .then_with(|| a.level.cmp(&b.level))
-            .then_with(|| a.material.cmp(&b.material))
-            .then_with(|| a.surface.cmp(&b.surface))
-            .then_with(|| {
-                a.normal_n
-                    .partial_cmp(&b.normal_n)
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            })
+    order.sort_by_cached_key(|(_, (key, spec))| {
+        let load = key.normal_n.map(f64::to_bits);
+        (
+            KernelKey::of(spec),
+            key.level,
+            key.material.clone(),
+            key.surface.clone(),
+            load,
+        )
     });
     let store = worker::kernel_store::FileStore::default_location();
     let mut cache: Option<(KernelKey, KernelCache)> = None;

@@ -104,31 +104,25 @@ pub fn preflight(spec: &CaseSpec, cache: &mut KernelCache) -> Result<Preflight, 
 /// Solves one case. Its kernel comes from (and stays in) `cache`.
 pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
     crate::base::progress::start_case();
-    let Start {
-        res,
-        terrain,
-        h0,
-        normal,
-        started,
-        kernel_seconds,
-    } = start(spec, cache)?;
-    let n = spec.grid.n;
+    let start = start(spec, cache)?;
+    let (res, terrain, h0) = (start.res, &start.terrain, &start.h0);
+    let (started, kernel_seconds) = (start.started, start.kernel_seconds);
     if let Some(history) = &spec.history {
         return solve_history_case(
             spec,
             history,
             res,
-            (&h0, &terrain),
-            normal,
+            (h0, terrain),
+            start.normal,
             started,
             kernel_seconds,
         );
     }
-    let state = crate::solve::coupling::solve_partial_slip(res, spec, &h0, normal)?;
-    check_inside(n, &state.p)?;
+    let state = crate::solve::coupling::solve_partial_slip(res, spec, h0, start.normal)?;
+    check_inside(spec.grid.n, &state.p)?;
     reduce(
         spec,
-        &terrain,
+        terrain,
         &mut res.operator,
         state,
         started,

@@ -29,18 +29,23 @@ fn preflight_reach_of_table_1a_is_the_hertz_radius_within_a_cell() {
     solve_case(&spec, &mut KernelCache::new()).unwrap();
 }
 
-/// The same case on 64 cells of 2 µm (the outermost cells at 63 µm, inside
-/// a = 105 µm): both refuse it, with the same error.
-#[test]
-fn preflight_refuses_a_contact_at_the_edge_as_the_solve_does() {
-    let spec = table_1a_fe(64, 2.0, true, 0.6);
-    let first = preflight(&spec, &mut KernelCache::new()).unwrap_err();
-    let solve = solve_case(&spec, &mut KernelCache::new()).err().unwrap();
+/// `spec` refused by the pre-flight and by the solve alike, for a contact
+/// at the domain's edge, with the same error.
+fn refused_at_the_edge_by_both(spec: &solver::CaseSpec) {
+    let first = preflight(spec, &mut KernelCache::new()).unwrap_err();
+    let solve = solve_case(spec, &mut KernelCache::new()).err().unwrap();
     assert!(
         matches!(first, SolverError::DomainTooSmall { .. }),
         "{first}"
     );
     assert_eq!(first, solve);
+}
+
+/// The same case on 64 cells of 2 µm (the outermost cells at 63 µm, inside
+/// a = 105 µm): both refuse it, with the same error.
+#[test]
+fn preflight_refuses_a_contact_at_the_edge_as_the_solve_does() {
+    refused_at_the_edge_by_both(&table_1a_fe(64, 2.0, true, 0.6));
 }
 
 /// A load path starts from its first turning point's normal load: 60 N
@@ -58,13 +63,7 @@ fn preflight_of_a_load_path_starts_from_its_first_load() {
     };
     let mut spec = table_1a_fe(256, 1.0, false, 0.3);
     spec.history = Some(path(60.0));
-    let first = preflight(&spec, &mut KernelCache::new()).unwrap_err();
-    let solve = solve_case(&spec, &mut KernelCache::new()).err().unwrap();
-    assert!(
-        matches!(first, SolverError::DomainTooSmall { .. }),
-        "{first}"
-    );
-    assert_eq!(first, solve);
+    refused_at_the_edge_by_both(&spec);
     spec.history = Some(path(20.0));
     let found = preflight(&spec, &mut KernelCache::new()).unwrap();
     assert!(found.reach < 1.0);
