@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Every test of the project, as the README gives it and CI runs it:
 #   1. the Rust workspace (`cargo test --workspace --release`);
-#   2. the Python package: `pip install ./python` into a fresh virtualenv
+#   2. every command of README.md's sh blocks, as written (tests/readme.sh:
+#      coarser grids, about 1.5 min of CPU);
+#   3. the Python package: `pip install ./python` into a fresh virtualenv
 #      (maturin from PyPI builds the native module with this checkout's
 #      Cargo.lock), then its pytest suite, which compares Python with the
 #      `mpcontact` binary built here.
@@ -19,6 +21,7 @@ cargo test --workspace --release
 cargo build --release --workspace --bin mpcontact
 target=${CARGO_TARGET_DIR:-$root/target}
 export MPCONTACT_CLI="$target/release/mpcontact"
+bash tests/readme.sh
 
 python=${PYTHON:-python3}
 if [ -n "${MPCONTACT_TEST_VENV:-}" ]; then

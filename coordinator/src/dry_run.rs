@@ -1,7 +1,8 @@
 //! What a sweep will do, without doing it: `mpcontact check CONFIG` and
 //! `mpcontact run CONFIG --dry-run`. The expanded sweep, the kernels to
-//! build or found in the cache, and estimates of memory and time. Reads the
-//! config and the kernel cache's headers; writes nothing.
+//! build or found in the cache, estimates of memory and time, and the first
+//! moments of every case (`preflight`: the normal contacts), refused as a
+//! solve would refuse them. Writes nothing.
 
 use anyhow::Result;
 use std::collections::BTreeMap;
@@ -13,18 +14,23 @@ use crate::cost::{
 };
 use solver::KernelKey;
 
-fn human_seconds(s: f64) -> String {
-    if s < 90.0 {
-        format!("{s:.0} s")
+/// An estimate of `s` seconds for people ("about 0 s" read as if nothing
+/// would run: below half a second it is "under 1 s").
+fn about_seconds(s: f64) -> String {
+    if s < 0.5 {
+        "under 1 s".into()
+    } else if s < 90.0 {
+        format!("about {s:.0} s")
     } else if s < 5400.0 {
-        format!("{:.1} min", s / 60.0)
+        format!("about {:.1} min", s / 60.0)
     } else {
-        format!("{:.1} h", s / 3600.0)
+        format!("about {:.1} h", s / 3600.0)
     }
 }
 
-/// The dry-run report of `config` run on `workers` workers; errors exactly as
-/// `run` would give them before starting (config, memory).
+/// The dry-run report of `config` run on `workers` workers; errors exactly
+/// as `run` would give them before starting (config, memory, a case refused
+/// in its first moments).
 pub fn report(config: &Config, workers: usize) -> Result<String> {
     let cases = config.cases()?;
     anyhow::ensure!(!cases.is_empty(), "the sweep has no cases");
@@ -58,6 +64,10 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         per_worker,
         workers,
         crate::memory::available_bytes(),
+    )?;
+    let first_moments = crate::preflight::check(
+        cases.iter().map(|(k, s)| (k, s)),
+        crate::preflight::Kernels::ReadOnly,
     )?;
     let mut s = String::new();
     let n0 = config.grid.points;
@@ -168,6 +178,14 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
         };
         let _ = writeln!(s, "           {material} at {n}²: {what}");
     }
+    if let Some((key, reach)) = &first_moments.widest {
+        let _ = writeln!(
+            s,
+            "contacts:  every case's frictionless normal contact solved ({:.1} s), none at the domain's edge; the widest, {key}, reaches {:.0} % of the way from the centre to the outermost cells",
+            first_moments.seconds,
+            100.0 * reach
+        );
+    }
     let workers_used = workers.min(cases.len()).max(1);
     let _ = writeln!(
         s,
@@ -205,8 +223,8 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
             .sum::<f64>();
     let _ = writeln!(
         s,
-        "time:      about {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^{CASE_EXPONENT}; a guide within a factor of 2)",
-        human_seconds(total / workers_used as f64),
+        "time:      {} on {workers_used} worker(s) ({:.2} s a case on average: the paper sweep's measured means per kind of case at 384², scaled as N^{CASE_EXPONENT}; a guide within a factor of 2)",
+        about_seconds(total / workers_used as f64),
         solving / cases.len() as f64
     );
     Ok(s)

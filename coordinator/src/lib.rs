@@ -10,7 +10,7 @@
 //! the workspace's `tests/tests/layers.rs`, which lists the modules in
 //! order): foundations (`case`, `convergence`, `float_text`,
 //! `solve_progress`, `scan_file`) → `config` →
-//! `memory`, `cost`, `output` → `solve`, `dry_run`, `shard` → `run`.
+//! `memory`, `cost`, `preflight`, `output` → `solve`, `dry_run`, `shard` → `run`.
 
 pub mod case;
 pub mod config;
@@ -20,6 +20,7 @@ pub mod dry_run;
 pub mod float_text;
 pub mod memory;
 pub mod output;
+pub mod preflight;
 pub mod run;
 pub mod scan_file;
 pub mod shard;

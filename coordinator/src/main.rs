@@ -28,9 +28,10 @@ enum Cmd {
         /// Number of worker processes (default: number of cores).
         #[arg(long)]
         workers: Option<usize>,
-        /// Output directory.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
+        /// Output directory (default: out/<config's file stem>, and
+        /// out/<stem>/shard-K for `--shard K/N`).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Continue an interrupted sweep from DIR/journal.jsonl.
         #[arg(long)]
         resume: bool,
@@ -77,6 +78,10 @@ enum Cmd {
         /// As `run --refine L`: a convergence ladder of L grids.
         #[arg(long, value_name = "L")]
         refine: Option<usize>,
+        /// The output directory `run` would write into (default: out/<config's
+        /// file stem>): whether it already holds a sweep.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Solve one case in-process and write case.json and the fields.
     Solve {
@@ -95,9 +100,9 @@ enum Cmd {
         /// the first of sweep.indenters, else indenter.material, else rigid).
         #[arg(long)]
         indenter: Option<String>,
-        /// Output directory.
-        #[arg(long, default_value = "out-solve")]
-        out: PathBuf,
+        /// Output directory (default: out-solve/<config's file stem>).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Override one config key.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         sets: Vec<String>,
@@ -206,10 +211,25 @@ fn worker_count(workers: Option<usize>) -> Result<usize> {
     Ok(workers)
 }
 
-/// The dry-run report, headed by the config's path.
-fn check_report(path: &std::path::Path, config: &Config, workers: usize) -> Result<String> {
+/// The dry-run report, headed by the config's path, with the folder `run`
+/// would write into (`out`) and what it holds.
+fn check_report(
+    path: &std::path::Path,
+    config: &Config,
+    workers: usize,
+    out: &std::path::Path,
+) -> Result<String> {
+    let journal = coordinator::run::JOURNAL_FILE;
+    let output = if out.join(journal).exists() {
+        format!(
+            "{} holds a sweep ({journal}): `run` continues it with --resume, or give another --out",
+            out.display()
+        )
+    } else {
+        out.display().to_string()
+    };
     Ok(format!(
-        "config:    {} (valid)\n{}nothing was solved or written (dry run)\n",
+        "config:    {} (valid)\n{}output:    {output}\nnothing was written (dry run; of the cases only their normal contacts were solved)\n",
         path.display(),
         coordinator::dry_run::report(config, workers)?
     ))
@@ -234,6 +254,27 @@ fn all_ok(ok: bool) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(coordinator::case::EXIT_NOT_ALL_OK)
+    }
+}
+
+/// Where `run` and `solve` write without `--out`: a folder named after the
+/// config file (`configs/quick.toml` → `quick`), under `out/` for a sweep
+/// (`out/<stem>/shard-K` for one shard) and `out-solve/` for one case. Two
+/// configs' sweeps never share a journal (a second sweep into one folder is
+/// refused: it would need `--resume`), and a solve never writes into a
+/// sweep's folder. A second solve of one config is a re-run and replaces it.
+fn default_out(
+    root: &str,
+    config: &std::path::Path,
+    shard: Option<coordinator::shard::Shard>,
+) -> PathBuf {
+    let stem = config
+        .file_stem()
+        .unwrap_or_else(|| std::ffi::OsStr::new("config"));
+    let dir = std::path::Path::new(root).join(stem);
+    match shard {
+        Some(s) => dir.join(format!("shard-{}", s.index)),
+        None => dir,
     }
 }
 
@@ -262,10 +303,11 @@ fn real_main() -> Result<ExitCode> {
                 .map(coordinator::shard::Shard::parse)
                 .transpose()?;
             let path = config.unwrap_or_else(|| PathBuf::from("configs/quick.toml"));
+            let out = out.unwrap_or_else(|| default_out("out", &path, shard));
             let config = Config::load(&path, &sets)?;
             let workers = worker_count(workers)?;
             if dry_run {
-                print!("{}", check_report(&path, &config, workers)?);
+                print!("{}", check_report(&path, &config, workers, &out)?);
                 return Ok(ExitCode::SUCCESS);
             }
             for w in config.unresolved_patterns(&config.sweep.surfaces)? {
@@ -280,6 +322,7 @@ fn real_main() -> Result<ExitCode> {
                 save_fields,
                 exe: coordinator::run::WorkerCommand::mpcontact(worker_exe()?),
                 shard,
+                names: coordinator::run::OptionNames::CLI,
             };
             let summary = coordinator::run::run_sweep(&args)?;
             Ok(all_ok(summary.without_result().is_none()))
@@ -296,6 +339,7 @@ fn real_main() -> Result<ExitCode> {
             quiet,
         } => {
             let cfg = Config::load(&config, &sets)?;
+            let out = out.unwrap_or_else(|| default_out("out-solve", &config, None));
             let threads = threads.map_or_else(solver::Threads::available, |n| n.get());
             let s = coordinator::solve::run_solve(
                 &cfg,
@@ -355,10 +399,15 @@ fn real_main() -> Result<ExitCode> {
             workers,
             mut sets,
             refine,
+            out,
         } => {
             sets.extend(refine_set(refine));
             let cfg = Config::load(&config, &sets)?;
-            print!("{}", check_report(&config, &cfg, worker_count(workers)?)?);
+            let out = out.unwrap_or_else(|| default_out("out", &config, None));
+            print!(
+                "{}",
+                check_report(&config, &cfg, worker_count(workers)?, &out)?
+            );
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Kernel {

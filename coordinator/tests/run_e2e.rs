@@ -2102,10 +2102,11 @@ fn issue50_a_sweep_with_a_hardness_reports_the_plastic_zone_of_solve() {
     }
 }
 
-/// Issue #59 item 6: a fretting map at `amplitudes_um = [1e-250]` spelt
+/// Issue #59 item 6: a fretting map at `amplitudes_um = [1e-5]` spelt
 /// the amplitude out in 264 characters: the case's history was lost to
 /// "File name too long", said only in summary.json's `output_warnings`,
-/// and the run exited 0. Now the id takes the shortest text (`1e-250`),
+/// and the run exited 0. Such a shift is refused since #60 (below 1 pm);
+/// at 1e-5 µm the id takes the shortest text (`1e-5`, not `0.00001`),
 /// the history is written, and an output that cannot be written (here a
 /// file in the way of `fields/`) is an error naming it, exit status 2,
 /// once the rest is written.
@@ -2116,16 +2117,16 @@ fn issue59_item6_a_tiny_map_amplitude_keeps_its_history_and_a_lost_output_is_an_
         "[grid]\npoints = 32\nspacing_um = 10.0\n\n",
         "[indenter]\nradius_mm = 18.0\n\n",
         "[load]\nnormal_n = 20.0\nfriction = 0.28571\n\n",
-        "[sweep]\nmaterials = [\"Fe\"]\nsurfaces = [\"flat\"]\nangles_deg = [0.0]\namplitudes_um = [1e-250]\n\n",
+        "[sweep]\nmaterials = [\"Fe\"]\nsurfaces = [\"flat\"]\nangles_deg = [0.0]\namplitudes_um = [1e-5]\n\n",
         "[history]\nfretting = { cycles = 1 }\nsteps_per_segment = 2\n\n",
         "[solver]\ncoupling = false\n",
     );
     std::fs::write(d.join("sweep.toml"), config).unwrap();
     check_ok(
         &sweep_cmd(&d, "out", 1, "ta").output().unwrap(),
-        "map at 1e-250 µm",
+        "map at 1e-5 µm",
     );
-    let case = d.join("out/fields/Fe/flat/000.0@1e-250um");
+    let case = d.join("out/fields/Fe/flat/000.0@1e-5um");
     assert!(case.join("history.csv").is_file(), "{}", case.display());
     assert!(summary(&d.join("out"))["output_warnings"]
         .as_array()
@@ -2139,7 +2140,7 @@ fn issue59_item6_a_tiny_map_amplitude_keeps_its_history_and_a_lost_output_is_an_
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("could not be written") && err.contains("history of Fe/flat/000.0@1e-250um"),
+        err.contains("could not be written") && err.contains("history of Fe/flat/000.0@1e-5um"),
         "{err}"
     );
     // Everything else was written, summary.json listing the lost output.
@@ -2155,23 +2156,48 @@ fn issue59_item6_a_tiny_map_amplitude_keeps_its_history_and_a_lost_output_is_an_
 
 /// Issue #59 item 7: Table 1(c) Cu with `hardness_gpa = 0.9` — every
 /// circle-A case reaches the domain's edge — said "ok" and exit 0, its
-/// curve left out of the figure without a word. Now the console says how
-/// many cases have no result, the run exits with status 4, the failures
-/// name the hardness, and the figure crosses the missing angles.
+/// curve left out of the figure without a word. Now (#62's pre-flight) the
+/// sweep is refused before it starts, each such case named with the
+/// hardness, exit status 2; and a sweep whose cases fail while it runs
+/// (here one that crashes every worker it is given) says on the console
+/// how many cases have no result, exits with status 4, and the figure
+/// crosses the missing angles.
 #[test]
 fn issue59_item7_a_sweep_whose_cases_fail_says_so_exits_4_and_marks_them() {
     let d = scratch("failing");
-    let config = concat!(
-        "[grid]\npoints = 96\nspacing_um = 80.0\n\n",
-        "[indenter]\nradius_mm = 200.0\n\n",
-        "[load]\nnormal_n = 6000.0\nfriction = 0.3\ntangential_ratio = 0.6\n\n",
-        "[sweep]\nmaterials = [\"Cu\"]\nsurfaces = [\"flat\", \"circle-A\"]\nangles_deg = [0.0, 45.0, 90.0]\n\n",
-        "[materials.Cu]\nhardness_gpa = 0.9\n",
-    );
-    std::fs::write(d.join("sweep.toml"), config).unwrap();
+    let config = |hardness: &str| {
+        format!(
+            concat!(
+                "[grid]\npoints = 96\nspacing_um = 80.0\n\n",
+                "[indenter]\nradius_mm = 200.0\n\n",
+                "[load]\nnormal_n = 6000.0\nfriction = 0.3\ntangential_ratio = 0.6\n\n",
+                "[sweep]\nmaterials = [\"Cu\"]\nsurfaces = [\"flat\", \"circle-A\"]\nangles_deg = [0.0, 45.0, 90.0]\n\n",
+                "[materials.Cu]\nhardness_gpa = {}\n",
+            ),
+            hardness
+        )
+    };
+    std::fs::write(d.join("sweep.toml"), config("0.9")).unwrap();
+    let out = sweep_cmd(&d, "refused", 2, "fr").output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for angle in ["000.0", "045.0", "090.0"] {
+        let line = err
+            .lines()
+            .find(|l| l.contains(&format!("Cu/circle-A/{angle}")))
+            .unwrap_or_else(|| panic!("{err}"));
+        assert!(
+            line.contains("edge of the domain") && line.contains("hardness"),
+            "{line}"
+        );
+    }
+    assert!(!d.join("refused/journal.jsonl").exists());
+    // Cases that fail while the sweep runs.
+    std::fs::write(d.join("sweep.toml"), config("3.0")).unwrap();
     for quiet in [false, true] {
         let out_name = if quiet { "quiet" } else { "out" };
         let mut cmd = sweep_cmd(&d, out_name, 2, if quiet { "fq" } else { "fo" });
+        cmd.env(CRASH_CASE_ENV, "Cu/circle-A/045.0");
         if quiet {
             cmd.arg("--quiet");
         }
@@ -2183,21 +2209,13 @@ fn issue59_item7_a_sweep_whose_cases_fail_says_so_exits_4_and_marks_them() {
             "{err}"
         );
         assert!(
-            err.contains("3 of 6 cases have no result (3 failed, 0 not converged)"),
+            err.contains("1 of 6 cases have no result (1 failed, 0 not converged)"),
             "{err}"
         );
         let o = d.join(out_name);
         let s = summary(&o);
-        for angle in ["000.0", "045.0", "090.0"] {
-            let why = s["failures"][format!("Cu/circle-A/{angle}")]
-                .as_str()
-                .unwrap();
-            assert!(
-                why.contains("edge of the domain") && why.contains("hardness"),
-                "{why}"
-            );
-        }
-        assert_eq!(s["incomplete_points"], 3);
+        assert!(s["failures"]["Cu/circle-A/045.0"].as_str().is_some(), "{s}");
+        assert_eq!(s["incomplete_points"], 1);
         let svg = std::fs::read_to_string(o.join("mu_a_vs_angle.svg")).unwrap();
         assert!(svg.contains("circle-A") && svg.contains("no result at this"));
     }

@@ -540,7 +540,8 @@ fn materials() -> Vec<String> {
 /// Runs a sweep as `mpcontact run` does — this process is the coordinator,
 /// workers are started as `program [args…] worker --run RUN --index K` —
 /// and returns summary.json's run part as a dict. Ctrl-C (or SIGTERM)
-/// stops it with `KeyboardInterrupt`; `--resume` continues.
+/// stops it with `KeyboardInterrupt`; `resume=True` continues. Messages
+/// name the keywords (`resume=True`, `out=`), not the CLI's flags.
 #[pyfunction]
 #[pyo3(signature = (cfg, workers, out, resume, quiet, save_fields, program, args))]
 #[allow(clippy::too_many_arguments)]
@@ -572,6 +573,7 @@ fn run<'py>(
             arg0: None,
         },
         shard: None,
+        names: coordinator::run::OptionNames::PYTHON,
     };
     let summary = py
         .detach(move || {

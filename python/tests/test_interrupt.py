@@ -112,7 +112,7 @@ def test_ctrl_c_stops_a_sweep_its_workers_exit_and_it_resumes(tmp_path):
     assert len(workers) == 2, workers
     p.send_signal(signal.SIGINT)
     line = p.stdout.readline()
-    assert line.startswith("interrupted:") and "--resume" in line, line + p.stderr.read()
+    assert line.startswith("interrupted:") and "resume=True" in line, line + p.stderr.read()
     assert not any(os.path.exists(f"/proc/{w}") for w in workers), "workers left behind"
     rest, err = p.communicate(timeout=600)
     assert rest.strip(), err

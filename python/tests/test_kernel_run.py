@@ -96,10 +96,16 @@ def test_run_resumes_and_defaults_to_a_temporary_directory(tmp_path):
     assert first.out.is_dir() and list(first.results["status"]) == ["ok"]
     again = mpcontact.run(cfg, workers=1, out=first.out, resume=True, progress=False)
     assert again.summary["resumed"] == 1
+    # Without resume=True the folder is refused, in Python's words (#62).
+    with pytest.raises(RuntimeError) as refused:
+        mpcontact.run(cfg, workers=1, out=first.out, progress=False)
+    text = str(refused.value)
+    assert "already holds a sweep" in text and "resume=True" in text and "out=" in text, text
+    assert "--resume" not in text and "--out" not in text, text
     with pytest.raises(ValueError, match="workers"):
         mpcontact.run(cfg, workers=0, out=tmp_path / "none", progress=False)
     (tmp_path / "file").write_text("")
-    with pytest.raises(RuntimeError, match="not a directory"):
+    with pytest.raises(RuntimeError, match="^out= .*file: exists and is not a directory"):
         mpcontact.run(cfg, workers=1, out=tmp_path / "file", progress=False)
 
 

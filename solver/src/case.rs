@@ -7,7 +7,7 @@ use crate::error::SolverError;
 use crate::model::spec::{CaseSpec, LoadHistory};
 use crate::model::surface::Terrain;
 use crate::post::results::{reduce, CaseOutput};
-use crate::solve::normal::NormalProblem;
+use crate::solve::normal::{NormalProblem, NormalSolution};
 use crate::solve::resident::{KernelCache, Resident};
 
 /// Fails when any cell of the outermost ring carries pressure: the contact
@@ -31,9 +31,21 @@ fn check_inside(spec: &CaseSpec, p: &[f64]) -> Result<(), SolverError> {
     Ok(())
 }
 
-/// Solves one case. Its kernel comes from (and stays in) `cache`.
-pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
-    crate::base::progress::start_case();
+/// What every case starts from: its kernel resident, the surface on the
+/// grid (heights and cover, once), the initial gap, and the frictionless
+/// normal contact under the first load, checked inside the domain.
+struct Start<'c> {
+    res: &'c mut Resident,
+    terrain: Terrain,
+    h0: Vec<f64>,
+    normal: NormalSolution,
+    started: std::time::Instant,
+    kernel_seconds: f64,
+}
+
+/// The first moments of a case, shared by [`solve_case`] and [`preflight`]:
+/// what they refuse is what the solve refuses before its tangential steps.
+fn start<'c>(spec: &CaseSpec, cache: &'c mut KernelCache) -> Result<Start<'c>, SolverError> {
     spec.validate()?;
     let (res, kernel_seconds) = cache.resident(spec)?;
     // The surface on the grid, once: an area-sampled pattern's cover is
@@ -45,21 +57,79 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     res.operator.set_cover(terrain.cover.as_deref());
     let started = std::time::Instant::now();
     let h0 = spec.initial_gap_on(&terrain.heights);
-    if let Some(history) = &spec.history {
-        return solve_history_case(spec, history, res, (&h0, &terrain), started, kernel_seconds);
-    }
+    // A load path starts from its first turning point's normal load.
+    let first_load = match &spec.history {
+        Some(history) => history.turning_points(&spec.load)[0].0,
+        None => spec.load.normal_force_n,
+    };
     let normal = res.solve_normal_from_rest(&NormalProblem {
         tolerance: spec.numerics.tolerance,
         max_iterations: spec.numerics.max_iterations,
         hardness: spec.limits().hardness,
-        ..NormalProblem::new(&h0, spec.load.normal_force_n)
+        ..NormalProblem::new(&h0, first_load)
     })?;
     check_inside(spec, &normal.p)?;
-    let state = crate::solve::coupling::solve_partial_slip(res, spec, &h0, normal)?;
+    Ok(Start {
+        res,
+        terrain,
+        h0,
+        normal,
+        started,
+        kernel_seconds,
+    })
+}
+
+/// What a case's first moments found ([`preflight`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Preflight {
+    /// How far the frictionless contact reaches towards the domain's edge:
+    /// the outermost loaded cell centre's distance from the domain's centre
+    /// (along x or y, whichever is larger) over the outermost ring's, which
+    /// [`solve_case`] refuses to load; below 1.
+    pub reach: f64,
+}
+
+/// Runs only the first moments of [`solve_case`] — validation, the kernel,
+/// the frictionless normal contact under the first load — and refuses what
+/// it would refuse there, with the same errors (a contact at the domain's
+/// edge, a normal solve that loses contact, an impossible input). A few
+/// normal solves' time; `mpcontact check` runs it on every case.
+pub fn preflight(spec: &CaseSpec, cache: &mut KernelCache) -> Result<Preflight, SolverError> {
+    let start = start(spec, cache)?;
+    let (grid, n) = (&spec.grid, spec.grid.n);
+    let mut reach = 0.0_f64;
+    for (i, &p) in start.normal.p.iter().enumerate() {
+        if p > 0.0 {
+            reach = reach.max(grid.x(i % n).abs().max(grid.y(i / n).abs()));
+        }
+    }
+    Ok(Preflight {
+        reach: reach / grid.x(n - 1),
+    })
+}
+
+/// Solves one case. Its kernel comes from (and stays in) `cache`.
+pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput, SolverError> {
+    crate::base::progress::start_case();
+    let start = start(spec, cache)?;
+    let (res, terrain, h0) = (start.res, &start.terrain, &start.h0);
+    let (started, kernel_seconds) = (start.started, start.kernel_seconds);
+    if let Some(history) = &spec.history {
+        return solve_history_case(
+            spec,
+            history,
+            res,
+            (h0, terrain),
+            start.normal,
+            started,
+            kernel_seconds,
+        );
+    }
+    let state = crate::solve::coupling::solve_partial_slip(res, spec, h0, start.normal)?;
     check_inside(spec, &state.p)?;
     reduce(
         spec,
-        &terrain,
+        terrain,
         &mut res.operator,
         state,
         started,
@@ -68,25 +138,19 @@ pub fn solve_case(spec: &CaseSpec, cache: &mut KernelCache) -> Result<CaseOutput
     )
 }
 
-/// A case with a load path: frictionless normal loading to the first
-/// turning point's load, the increments, and the scalars and fields of the
-/// final state with the path's table.
+/// A case with a load path: from the frictionless normal contact under the
+/// first turning point's load (`normal`), the increments, and the scalars
+/// and fields of the final state with the path's table.
 fn solve_history_case(
     spec: &CaseSpec,
     history: &LoadHistory,
     res: &mut Resident,
     (h0, terrain): (&[f64], &Terrain),
+    normal: NormalSolution,
     started: std::time::Instant,
     kernel_seconds: f64,
 ) -> Result<CaseOutput, SolverError> {
     let points = history.turning_points(&spec.load);
-    let normal = res.solve_normal_from_rest(&NormalProblem {
-        tolerance: spec.numerics.tolerance,
-        max_iterations: spec.numerics.max_iterations,
-        hardness: spec.limits().hardness,
-        ..NormalProblem::new(h0, points[0].0)
-    })?;
-    check_inside(spec, &normal.p)?;
     let solved =
         crate::solve::history::solve_history(res, spec, history, (h0, terrain), normal, |p| {
             check_inside(spec, p)

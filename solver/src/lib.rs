@@ -102,7 +102,7 @@ pub use solve::window;
 pub use base::grid::Grid;
 pub use base::parallel::Threads;
 pub use base::progress::{cancel, phase, set_tick_hook, Phase, Stage, TickHook};
-pub use case::solve_case;
+pub use case::{preflight, solve_case, Preflight};
 pub use error::SolverError;
 pub use model::material::{
     hill_average, pair_influence, Anisotropic, ElasticModel, Elasticity, Isotropic, Limits,

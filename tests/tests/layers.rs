@@ -78,6 +78,7 @@ fn coordinator() -> Layers {
             ("", "config"),
             ("", "memory"),
             ("", "cost"),
+            ("", "preflight"),
             ("output", "atomic"),
             ("output", "npy"),
             ("output", "plot"),

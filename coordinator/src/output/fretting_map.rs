@@ -11,7 +11,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::plot::{self, err, Area, Figure, Frame, Panels, PALETTE};
+use super::plot::{self, err, Area, Figure, Frame, Panels, Unit, PALETTE};
 use super::sweep::{csv_field as cell, Row};
 use crate::float_text::{fmt_f64, fmt_opt as opt};
 
@@ -326,15 +326,30 @@ impl Figure for MapFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> anyhow::Result<()> {
         let (panels, by_load) = (&self.panels, self.by_load);
         let (areas, legend) = self.layout.split(root);
+        // Units that read 1–1000, the same in every panel: the amplitude
+        // (µm), the normal load (N or kN) or the energy per cycle.
+        let all = panels.iter().flat_map(|p| p.points.iter());
+        let largest = |f: &dyn Fn(&MapPoint) -> Option<f64>| {
+            all.clone()
+                .filter_map(|p| f(p))
+                .fold(0.0_f64, |m, v| m.max(v.abs()))
+        };
+        let ux = Unit::for_largest("m", 1, largest(&|p| Some(p.amplitude_um * 1e-6)));
+        let uy = if by_load {
+            Unit::for_largest("N", 1, largest(&|p| Some(p.normal_n)))
+        } else {
+            Unit::for_largest("J", 1, largest(&|p| p.dissipated_j))
+        };
+        let x_of = |amplitude_um: f64| amplitude_um * 1e-6 * ux.factor;
         let y_of = |p: &MapPoint| -> Option<f64> {
             if by_load {
-                Some(p.normal_n)
+                Some(p.normal_n * uy.factor)
             } else {
-                p.dissipated_j.map(|w| w * 1e3)
+                p.dissipated_j.map(|w| w * uy.factor)
             }
         };
         for (panel, area) in panels.iter().zip(areas.iter()) {
-            let xs = panel.points.iter().map(|p| p.amplitude_um);
+            let xs = panel.points.iter().map(|p| x_of(p.amplitude_um));
             let (xlo, xhi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
                 (a.min(x), b.max(x))
             });
@@ -348,7 +363,7 @@ impl Figure for MapFigure<'_> {
                 (ylo, yhi) = (0.0, 1.0);
             }
             if by_load {
-                let pad = ((yhi - ylo) * 0.1).max(0.1 * yhi.abs().max(1.0));
+                let pad = ((yhi - ylo) * 0.1).max(0.1 * yhi.abs().max(1e-3));
                 (ylo, yhi) = (ylo - pad, yhi + pad);
             } else {
                 (ylo, yhi) = (0.0, yhi.max(1e-12) * 1.1);
@@ -365,29 +380,22 @@ impl Figure for MapFigure<'_> {
                 labels: (40, 70),
             };
             let mut chart = frame.chart(area, &panel.title, xlo..xhi, ylo..yhi)?;
-            chart
-                .configure_mesh()
-                .x_desc("displacement amplitude Δ (µm)")
-                .y_desc(if by_load {
-                    "normal load P (N)"
-                } else {
-                    "energy per cycle (mJ)"
-                })
-                .y_label_formatter(&|y| {
-                    if by_load {
-                        format!("{y:.0}")
-                    } else {
-                        format!("{y:.1}")
-                    }
-                })
-                .x_label_formatter(&|x| format!("{x}"))
-                .draw()
-                .map_err(err)?;
+            let y_desc = if by_load {
+                format!("normal load P ({})", uy.text)
+            } else {
+                format!("energy per cycle ({})", uy.text)
+            };
+            plot::axes(
+                &mut chart,
+                &format!("displacement amplitude Δ ({})", ux.text),
+                &y_desc,
+                true,
+            )?;
             if !by_load {
                 let mut line: Vec<(f64, f64)> = panel
                     .points
                     .iter()
-                    .filter_map(|p| Some((p.amplitude_um, y_of(p)?)))
+                    .filter_map(|p| Some((x_of(p.amplitude_um), y_of(p)?)))
                     .collect();
                 line.sort_by(|a, b| a.0.total_cmp(&b.0));
                 chart
@@ -401,7 +409,7 @@ impl Figure for MapFigure<'_> {
                 .draw_series(panel.points.iter().filter_map(|p| {
                     let y = y_of(p)?;
                     let c = regime_colour(p.regime.as_deref());
-                    Some(Circle::new((p.amplitude_um, y), 6, c.filled()))
+                    Some(Circle::new((x_of(p.amplitude_um), y), 6, c.filled()))
                 }))
                 .map_err(err)?;
             // The transition: a dashed vertical line with one load, the
@@ -410,7 +418,8 @@ impl Figure for MapFigure<'_> {
             if by_load {
                 let mut t = panel.transitions.clone();
                 t.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let line: Vec<(f64, f64)> = t.iter().map(|&(p, a)| (a, p)).collect();
+                let line: Vec<(f64, f64)> =
+                    t.iter().map(|&(p, a)| (x_of(a), p * uy.factor)).collect();
                 chart
                     .draw_series(LineSeries::new(line.clone(), black))
                     .map_err(err)?;
@@ -418,13 +427,14 @@ impl Figure for MapFigure<'_> {
                     .draw_series(line.iter().map(|&c| Cross::new(c, 6, black)))
                     .map_err(err)?;
             } else {
-                for &(_, a) in &panel.transitions {
+                for &(_, a_um) in &panel.transitions {
+                    let a = x_of(a_um);
                     chart
                         .draw_series(DashedLineSeries::new([(a, ylo), (a, yhi)], 6, 4, black))
                         .map_err(err)?;
                     chart
                         .draw_series([Text::new(
-                            format!(" transition {a:.2} µm"),
+                            format!(" transition {a:.2} {}", ux.text),
                             (a, yhi),
                             ("sans-serif", 14).into_font(),
                         )])

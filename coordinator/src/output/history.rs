@@ -10,7 +10,7 @@ use solver::{Grid, HistoryOutput};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::plot::{self, err, Area, Figure, Frame, PALETTE};
+use super::plot::{self, Area, Figure, Frame, Unit, PALETTE};
 
 /// Header of `history.csv`.
 pub const HISTORY_HEADER: &str = "step,normal_force_n,fx_n,fy_n,delta_x_m,delta_y_m,delta_z_m,contact_area_m2,stick_area_m2,stick_radius_m,dissipated_j,segment,converged,segment_increments";
@@ -74,13 +74,13 @@ pub fn history_csv(h: &HistoryOutput) -> String {
     out
 }
 
-/// The loop's lines: (label, [(δt µm, F N)]) along the force direction. The
+/// The loop's lines: (label, [(δt m, F N)]) along the force direction. The
 /// first loading is its own line; then one line per cycle (two segments).
 fn loop_lines(h: &HistoryOutput) -> Vec<(String, Vec<(f64, f64)>)> {
     let along = |v: [f64; 2]| v[0] * h.direction[0] + v[1] * h.direction[1];
     let point = |k: usize| {
         let r = &h.steps[k];
-        (along(r.delta_t_m) * 1e6, along(r.force_n))
+        (along(r.delta_t_m), along(r.force_n))
     };
     let t = &h.turning_steps;
     let mut lines = Vec::new();
@@ -124,10 +124,34 @@ pub fn plot_hysteresis(path: &Path, h: &HistoryOutput, title: &str) -> Result<()
     plot::write(path, (760, 520), &Hysteresis { lines, title })
 }
 
+/// At most this many cycles are drawn: the first, the last and evenly
+/// spaced ones between (a worn path has a hundred; `history.csv` has all).
+const CYCLES_DRAWN: usize = 5;
+
+/// Which of `n` cycles are drawn (0-based, ascending).
+fn drawn_cycles(n: usize) -> Vec<usize> {
+    if n <= CYCLES_DRAWN {
+        return (0..n).collect();
+    }
+    let mut v: Vec<usize> = (0..CYCLES_DRAWN)
+        .map(|i| (i as f64 * (n - 1) as f64 / (CYCLES_DRAWN - 1) as f64).round() as usize)
+        .collect();
+    v.dedup();
+    v
+}
+
 impl Figure for Hysteresis<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
-        let lines = &self.lines;
-        let pts = lines.iter().flat_map(|(_, l)| l.iter());
+        let Some((first, cycles)) = self.lines.split_first() else {
+            return Ok(());
+        };
+        let cycles: Vec<&(String, Vec<(f64, f64)>)> = drawn_cycles(cycles.len())
+            .into_iter()
+            .map(|k| &cycles[k])
+            .collect();
+        let pts = std::iter::once(first)
+            .chain(cycles.iter().copied())
+            .flat_map(|(_, l)| l.iter());
         let (mut xlo, mut xhi, mut ylo, mut yhi) = (
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -140,9 +164,30 @@ impl Figure for Hysteresis<'_> {
             ylo = ylo.min(y);
             yhi = yhi.max(y);
         }
-        if !xlo.is_finite() || xhi <= xlo || yhi <= ylo {
+        // δt and F in the units that make them read 1–1000 (nm or µm; N).
+        let (ux, uy) = if !xlo.is_finite() || xhi <= xlo || yhi <= ylo {
             (xlo, xhi, ylo, yhi) = (-1.0, 1.0, -1.0, 1.0);
-        }
+            (
+                Unit::for_largest("m", 1, 0.0),
+                Unit::for_largest("N", 1, 0.0),
+            )
+        } else {
+            (
+                Unit::for_largest("m", 1, xlo.abs().max(xhi.abs())),
+                Unit::for_largest("N", 1, ylo.abs().max(yhi.abs())),
+            )
+        };
+        let scaled = |l: &[(f64, f64)]| -> Vec<(f64, f64)> {
+            l.iter()
+                .map(|&(x, y)| (x * ux.factor, y * uy.factor))
+                .collect()
+        };
+        let (xlo, xhi, ylo, yhi) = (
+            xlo * ux.factor,
+            xhi * ux.factor,
+            ylo * uy.factor,
+            yhi * uy.factor,
+        );
         let (xp, yp) = ((xhi - xlo) * 0.05, (yhi - ylo) * 0.05);
         let frame = Frame {
             title: 20,
@@ -155,21 +200,30 @@ impl Figure for Hysteresis<'_> {
             (xlo - xp)..(xhi + xp),
             (ylo - yp)..(yhi + yp),
         )?;
-        chart
-            .configure_mesh()
-            .x_desc("tangential shift δt along the force (μm)")
-            .y_desc("tangential force F (N)")
-            .draw()
-            .map_err(err)?;
-        for (k, (label, line)) in lines.iter().enumerate() {
-            // The first loading black, then the cycles in the palette's
-            // first five colours, and again.
-            let colour = match k % 6 {
-                0 => BLACK,
-                c => PALETTE[c - 1],
-            };
-            plot::labelled_line(&mut chart, line, colour, label)?;
+        plot::axes(
+            &mut chart,
+            &format!("tangential shift δt along the force ({})", ux.text),
+            &format!("tangential force F ({})", uy.text),
+            true,
+        )?;
+        // A loop closes after its first cycle, so the later cycles run on
+        // top of the earlier ones: each is drawn narrower than the one
+        // before it, on top, and cycle 1 stays visible as the outermost band
+        // (before #62 cycle 2 hid it). The cycles in the palette's first
+        // five colours; the first loading in black, first in the legend and
+        // drawn again over the cycles.
+        let first_line = scaled(&first.1);
+        plot::labelled_line(&mut chart, &first_line, (BLACK, 2), &first.0)?;
+        // 4 px narrower each (2 px with five cycles: the widest 10 px).
+        let step = (10 / cycles.len().saturating_sub(1).max(1)).min(4) as u32;
+        for (k, (label, line)) in cycles.iter().enumerate() {
+            let width = 2 + step * (cycles.len() - 1 - k) as u32;
+            let colour = PALETTE[k % 5];
+            plot::labelled_line(&mut chart, &scaled(line), (colour, width), label)?;
         }
+        chart
+            .draw_series(LineSeries::new(first_line, BLACK.stroke_width(2)))
+            .map_err(plot::err)?;
         plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     }
@@ -275,14 +329,23 @@ mod tests {
         assert!(lines[3].ends_with(",true,0,2e-9,2e-7"), "{}", lines[3]);
     }
 
+    /// Up to five cycles all; of more, the first, the last and three
+    /// evenly between.
+    #[test]
+    fn issue62_the_loop_draws_the_first_and_last_cycles_of_a_long_path() {
+        assert_eq!(drawn_cycles(2), [0, 1]);
+        assert_eq!(drawn_cycles(5), [0, 1, 2, 3, 4]);
+        assert_eq!(drawn_cycles(100), [0, 25, 50, 74, 99]);
+    }
+
     #[test]
     fn loop_lines_split_first_loading_and_cycles() {
         let lines = loop_lines(&history());
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[0].1.len(), 3);
         // The cycle runs from the first turning point back to the last.
-        assert_eq!(lines[1].1.first(), Some(&(3.0, 2.0)));
-        assert_eq!(lines[1].1.last(), Some(&(3.0, 2.0)));
+        assert_eq!(lines[1].1.first(), Some(&(3e-6, 2.0)));
+        assert_eq!(lines[1].1.last(), Some(&(3e-6, 2.0)));
         assert_eq!(lines[1].1.len(), 5);
         // A cycle of auto increments is not drawn (a few points are no loop).
         let mut auto = history();

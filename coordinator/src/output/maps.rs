@@ -12,18 +12,35 @@ use solver::{CaseScalars, Fields};
 use std::borrow::Cow;
 use std::path::Path;
 
-use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame};
+use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame, Unit};
 
 /// The size of a map (PNG).
 const SIZE: (u32, u32) = (760, 640);
 /// The width of the map; its colour bar takes the rest.
 const MAP_WIDTH: u32 = 620;
 
-/// One map: `values` (n x n, row-major [iy][ix]) drawn over |x|, |y| ≤ extent·a.
+/// One map: `values` (n x n, row-major [iy][ix]) drawn over |x|, |y| ≤
+/// extent·a, under `label`; with a `unit` (`m`), the values are in it and
+/// shown with the prefix that makes them read 1–1000 ([`Unit`]).
 struct Map<'a> {
     file: Cow<'a, str>,
     label: Cow<'a, str>,
     values: Vec<f64>,
+    unit: Option<&'static str>,
+}
+
+impl Map<'_> {
+    /// The map with its values in the unit that reads 1–1000 and the unit
+    /// named in its label (as it is: without a unit).
+    fn in_its_unit(mut self) -> Self {
+        if let Some(base) = self.unit.take() {
+            let largest = self.values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let u = Unit::for_largest(base, 1, largest);
+            self.values.iter_mut().for_each(|v| *v *= u.factor);
+            self.label = format!("{} ({})", self.label, u.text).into();
+        }
+        self
+    }
 }
 
 /// The colour bar beside a map: the ramp from `lo` to `hi` under `label`.
@@ -33,7 +50,6 @@ fn colour_bar<DB: DrawingBackend>(bar: &Area<DB>, label: &str, lo: f64, hi: f64)
         title: 14,
         margins: [12, 50, 8, 8],
         ticks: 13,
-        decimals: 3,
         steps: 200,
     }
     .draw(bar, lo, hi)
@@ -83,13 +99,7 @@ impl Figure for MapFigure<'_> {
             labels: (40, 50),
         };
         let mut chart = frame.chart(&main, title, -extent..extent, -extent..extent)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("x / a")
-            .y_desc("y / a")
-            .draw()
-            .map_err(err)?;
+        plot::axes(&mut chart, "x / a", "y / a", false)?;
         let h = 0.5 * dx / a;
         chart
             .draw_series((0..n).filter(|&i| inside(i)).flat_map(|iy| {
@@ -125,7 +135,7 @@ pub fn write_maps(
         .sx
         .iter()
         .zip(&fields.sy)
-        .map(|(x, y)| x.hypot(*y) * 1e6)
+        .map(|(x, y)| x.hypot(*y))
         .collect();
     // Stick/slip map: 0 outside contact, 1 slip, 2 stick.
     let status: Vec<f64> = (0..n * n)
@@ -144,48 +154,55 @@ pub fn write_maps(
             file: "p.png".into(),
             label: "p / p_H".into(),
             values: norm(&fields.p),
+            unit: None,
         },
         Map {
             file: "qx.png".into(),
             label: "qx / p_H".into(),
             values: norm(&fields.qx),
+            unit: None,
         },
         Map {
             file: "qy.png".into(),
             label: "qy / p_H".into(),
             values: norm(&fields.qy),
+            unit: None,
         },
         Map {
             file: "slip.png".into(),
-            label: "|s| (µm)".into(),
+            label: "|s|".into(),
             values: slip,
+            unit: Some("m"),
         },
         Map {
             file: "stick.png".into(),
             label: "0 free, 1 slip, 2 stick".into(),
             values: status,
+            unit: None,
         },
     ];
     // On a surface with a hardness: the dent (permanent plastic
-    // penetration), µm.
+    // penetration).
     if !fields.plastic.is_empty() {
         maps.push(Map {
             file: "plastic.png".into(),
-            label: "plastic penetration (µm)".into(),
-            values: fields.plastic.iter().map(|w| w * 1e6).collect(),
+            label: "plastic penetration".into(),
+            values: fields.plastic.clone(),
+            unit: Some("m"),
         });
     }
-    // After a path with a wear law: the worn depths, µm (the substrate's
-    // in its own frame, the ball's in the grid's).
+    // After a path with a wear law: the worn depths (the substrate's in
+    // its own frame, the ball's in the grid's).
     for (file, label, worn) in [
-        ("wear.png", "worn depth (µm)", &fields.wear),
-        ("ball_wear.png", "ball worn (µm)", &fields.ball_wear),
+        ("wear.png", "worn depth", &fields.wear),
+        ("ball_wear.png", "ball worn", &fields.ball_wear),
     ] {
         if !worn.is_empty() {
             maps.push(Map {
                 file: file.into(),
                 label: label.into(),
-                values: worn.iter().map(|w| w * 1e6).collect(),
+                values: worn.clone(),
+                unit: Some("m"),
             });
         }
     }
@@ -193,12 +210,14 @@ pub fn write_maps(
     for (cycle, worn) in &fields.wear_saved {
         maps.push(Map {
             file: format!("wear_cycle_{cycle}.png").into(),
-            label: format!("worn depth, simulated cycle {cycle} (µm)").into(),
-            values: worn.iter().map(|w| w * 1e6).collect(),
+            label: format!("worn depth, simulated cycle {cycle}").into(),
+            values: worn.clone(),
+            unit: Some("m"),
         });
     }
     let extent = (1.3_f64).min(0.5 * n as f64 * spacing_m / a);
-    for m in &maps {
+    for m in maps.into_iter().map(Map::in_its_unit) {
+        let m = &m;
         let path = dir.join(m.file.as_ref());
         let label = format!("{title}: {}", m.label);
         let figure = MapFigure {
@@ -275,13 +294,7 @@ impl Figure for Heat<'_> {
             labels: (40, 50),
         };
         let mut chart = frame.chart(&main, m.title, x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(m.axes.0)
-            .y_desc(m.axes.1)
-            .draw()
-            .map_err(err)?;
+        plot::axes(&mut chart, m.axes.0, m.axes.1, false)?;
         let (dx, dy) = (2.0 * hx, 2.0 * hy);
         chart
             .draw_series((0..m.rows).flat_map(|r| {

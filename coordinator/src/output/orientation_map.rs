@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use plotters::prelude::*;
 
-use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame};
+use super::plot::{self, err, ramp, Area, ColourBar, Figure, Frame, Unit};
 use super::sweep::{csv_field, Axes, CurvePoint, Row};
 use crate::case::CaseKey;
 use crate::config::orientations::{ipf_xy, miller_text};
@@ -242,8 +242,11 @@ pub struct IpfMap {
     pub path: PathBuf,
     /// Title.
     pub title: String,
-    /// Colour-bar label.
+    /// Colour-bar label: the quantity, without its unit.
     pub label: String,
+    /// The values' SI unit (`Pa`, `J`), shown with the prefix that makes
+    /// them read 1–1000 (`plot::Unit`); `None` for a ratio.
+    pub unit: Option<&'static str>,
     /// (normal, value) of each orientation.
     pub points: Vec<([f64; 3], f64)>,
 }
@@ -293,13 +296,15 @@ pub fn ipf_maps(rows: &[OrientationRow]) -> Vec<IpfMap> {
             maps.push(IpfMap {
                 path: dir.join("indentation_modulus"),
                 title: format!("{base}: indentation modulus M (Vlassak–Nix)"),
-                label: "M (GPa)".into(),
-                points: one(&|r| r.modulus / 1e9),
+                label: "M".into(),
+                unit: Some("Pa"),
+                points: one(&|r| r.modulus),
             });
             maps.push(IpfMap {
                 path: dir.join("compliance_ratio"),
                 title: format!("{base}: tangential / normal compliance"),
                 label: "⟨H11+H22⟩/2⟨H33⟩".into(),
+                unit: None,
                 points: one(&|r| r.compliance_ratio),
             });
         }
@@ -309,68 +314,77 @@ pub fn ipf_maps(rows: &[OrientationRow]) -> Vec<IpfMap> {
         ));
         let what = format!("{base} / {}{}", r0.key.surface, ball_and_axes(&r0.key));
         let angles = rs.iter().map(|r| r.angles).max().unwrap_or(0);
-        let mut add =
-            |stem: &str, title: String, label: &str, f: &dyn Fn(&OrientationRow) -> Option<f64>| {
-                let pts: Option<Vec<([f64; 3], f64)>> = rs
+        let mut add = |stem: &str,
+                       title: String,
+                       (label, unit): (&str, Option<&'static str>),
+                       f: &dyn Fn(&OrientationRow) -> Option<f64>| {
+            let pts: Option<Vec<([f64; 3], f64)>> = rs
+                .iter()
+                .map(|r| Some((r.orientation.normal, f(r)?)))
+                .collect();
+            // A constant (μa on a flat surface whose K_E calibrates on
+            // itself, a range that is zero) is no map.
+            let varies = |p: &Vec<([f64; 3], f64)>| {
+                let (lo, hi) = p
                     .iter()
-                    .map(|r| Some((r.orientation.normal, f(r)?)))
-                    .collect();
-                // A constant (μa on a flat surface whose K_E calibrates on
-                // itself, a range that is zero) is no map.
-                let varies = |p: &Vec<([f64; 3], f64)>| {
-                    let (lo, hi) = p
-                        .iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-                            (a.min(q.1), b.max(q.1))
-                        });
-                    hi - lo > 1e-9 * lo.abs().max(hi.abs())
-                };
-                if let Some(points) = pts.filter(|p| !p.is_empty() && varies(p)) {
-                    maps.push(IpfMap {
-                        path: surface_dir.join(stem),
-                        title,
-                        label: label.into(),
-                        points,
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+                        (a.min(q.1), b.max(q.1))
                     });
-                }
+                hi - lo > 1e-9 * lo.abs().max(hi.abs())
             };
+            if let Some(points) = pts.filter(|p| !p.is_empty() && varies(p)) {
+                maps.push(IpfMap {
+                    path: surface_dir.join(stem),
+                    title,
+                    label: label.into(),
+                    unit,
+                    points,
+                });
+            }
+        };
         let over = if angles > 1 {
             format!("mean over {angles} force angles")
         } else {
             "one force angle".into()
         };
-        add("mu_a", format!("{what}: μa, {over}"), "μa", &|r| {
-            Some(r.mu_a?.0)
-        });
-        add("k_e", format!("{what}: K_E, {over}"), "K_E (GPa)", &|r| {
-            Some(r.k_e?.0 / 1e9)
-        });
+        add(
+            "mu_a",
+            format!("{what}: μa, {over}"),
+            ("μa", None),
+            &|r| Some(r.mu_a?.0),
+        );
+        add(
+            "k_e",
+            format!("{what}: K_E, {over}"),
+            ("K_E", Some("Pa")),
+            &|r| Some(r.k_e?.0),
+        );
         if angles > 1 {
             add(
                 "k_e_range",
                 format!("{what}: range of K_E over {angles} force angles"),
-                "max − min K_E (GPa)",
-                &|r| r.k_e.map(|(_, lo, hi)| (hi - lo) / 1e9),
+                ("max − min K_E", Some("Pa")),
+                &|r| r.k_e.map(|(_, lo, hi)| hi - lo),
             );
         }
         add(
             "energy_per_cycle",
             format!("{what}: energy per cycle, {over}"),
-            "W (µJ)",
-            &|r| Some(r.dissipated?.0 * 1e6),
+            ("W", Some("J")),
+            &|r| Some(r.dissipated?.0),
         );
         if angles > 1 {
             add(
                 "mu_a_range",
                 format!("{what}: range of μa over {angles} force angles"),
-                "max − min μa",
+                ("max − min μa", None),
                 &|r| r.mu_a.map(|(_, lo, hi)| hi - lo),
             );
             add(
                 "energy_per_cycle_range",
                 format!("{what}: range of the energy per cycle over {angles} angles"),
-                "max − min W (µJ)",
-                &|r| r.dissipated.map(|(_, lo, hi)| (hi - lo) * 1e6),
+                ("max − min W", Some("J")),
+                &|r| r.dissipated.map(|(_, lo, hi)| hi - lo),
             );
         }
     }
@@ -561,18 +575,22 @@ impl Figure for IpfMap {
                 .draw_series(std::iter::once(Text::new(text, at, font.clone())))
                 .map_err(err)?;
         }
-        // Colour bar, with as many decimals as its span needs (three figures
-        // of the difference).
-        let decimals = ((-(hi - lo).log10()).ceil() + 2.0).clamp(0.0, 8.0) as usize;
+        // Colour bar: in the unit that reads 1–1000, ticks by the one rule.
+        let (label, factor) = match map.unit {
+            Some(base) => {
+                let u = Unit::for_largest(base, 1, lo.abs().max(hi.abs()));
+                (format!("{} ({})", map.label, u.text), u.factor)
+            }
+            None => (map.label.clone(), 1.0),
+        };
         ColourBar {
-            label: &map.label,
+            label: &label,
             title: 13,
             margins: [30, 40, 6, 0],
             ticks: 12,
-            decimals,
             steps: 120,
         }
-        .draw(&bar, lo, hi)
+        .draw(&bar, lo * factor, hi * factor)
     }
 }
 

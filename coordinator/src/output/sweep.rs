@@ -599,10 +599,29 @@ pub fn curve_summaries(points: &[CurvePoint]) -> BTreeMap<String, CurveSummary> 
 #[derive(Default)]
 struct Panel {
     title: String,
-    y_desc: &'static str,
+    y_desc: String,
     series: BTreeMap<String, Vec<(f64, f64, Option<f64>)>>,
     flagged: Vec<(String, f64, f64)>,
     missing: BTreeMap<String, Vec<f64>>,
+}
+
+/// `panels` (one quantity, values in the SI unit `base` to the `power`)
+/// in the one unit that makes the largest of them read 1–1000
+/// ([`plot::Unit`]), their y axis `what (unit)`.
+fn in_unit(mut panels: Vec<Panel>, what: &str, base: &str, power: i32) -> Vec<Panel> {
+    let largest = panels
+        .iter()
+        .flat_map(|p| p.series.values().flatten())
+        .fold(0.0_f64, |m, &(_, y, e)| m.max(y.abs() + e.unwrap_or(0.0)));
+    let u = plot::Unit::for_largest(base, power, largest);
+    for p in &mut panels {
+        p.y_desc = format!("{what} ({})", u.text);
+        for (_, y, e) in p.series.values_mut().flatten() {
+            *y *= u.factor;
+            *e = e.map(|e| e * u.factor);
+        }
+    }
+    panels
 }
 
 /// One panel per material, titled "material: `what`", of `value` (y and
@@ -611,7 +630,7 @@ struct Panel {
 fn panels_of(
     points: &[CurvePoint],
     what: &str,
-    y_desc: &'static str,
+    y_desc: &str,
     value: impl Fn(&CurvePoint) -> Option<(f64, Option<f64>)>,
 ) -> Vec<Panel> {
     let mut panels: BTreeMap<&str, Panel> = BTreeMap::new();
@@ -628,7 +647,7 @@ fn panels_of(
                 .entry(material)
                 .or_insert_with(|| Panel {
                     title: format!("{material}: {what}"),
-                    y_desc,
+                    y_desc: y_desc.to_string(),
                     ..Default::default()
                 })
                 .series
@@ -641,24 +660,21 @@ fn panels_of(
 /// Draw μa versus angle to `path` (PNG or SVG by extension): one panel per
 /// material, one series per surface with markers at the computed angles
 /// and error bars where a ladder gave them, the flat surface in black; and,
-/// when a material's K_E was calibrated on its flat surface, a panel of
-/// K_E(ψ) (GPa) for those materials; on a surface with a hardness, a panel
-/// per material of the area at the hardness (mm²); with `[stress]`, a panel
-/// per material of the largest von Mises stress over p_H. The legend sits
-/// beside the panels. A μa on a pressure that is not Hertz's
+/// per material whose K_E was calibrated on its flat surface, a panel of
+/// that K_E(ψ) (its series the flat surface's, so that every line of the
+/// figure is a surface of the one legend); on a surface with a hardness, a
+/// panel per material of the area at the hardness; with `[stress]`, a panel
+/// per material of the largest von Mises stress over p_H. Units read
+/// 1–1000 ([`plot::Unit`]). The legend sits beside the panels, or in the
+/// last row's empty cell. A μa on a pressure that is not Hertz's
 /// (`mu_a_non_hertz`) is ringed; the `missing` points (failed or not
 /// converged, [`curve_points`]) are crossed on the floor of their
 /// material's μa panel, so that a curve without them says so (#59).
 pub fn plot_curves(path: &Path, points: &[CurvePoint], missing: &[CaseKey]) -> anyhow::Result<()> {
     let mut by_material: BTreeMap<&str, Panel> = BTreeMap::new();
-    let mut k_e = Panel {
-        title: "K_E(ψ), flat-surface calibration".into(),
-        y_desc: "K_E (GPa)",
-        ..Default::default()
-    };
     let mu_a_panel = |material: &str| Panel {
         title: material.to_string(),
-        y_desc: "apparent friction μa (–)",
+        y_desc: "apparent friction μa (–)".into(),
         ..Default::default()
     };
     for ((material, surface), pts) in by_curve(points) {
@@ -674,37 +690,18 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint], missing: &[CaseKey]) -> a
                 .map(|p| (surface.clone(), p.key.angle_deg, p.mu_a.value)),
         );
         panel.series.insert(surface, mu.collect());
-        if pts.iter().all(|p| p.flat_calibration) {
-            let gpa = |v: f64| v / 1e9;
-            let ke = pts
-                .iter()
-                .map(|p| (p.key.angle_deg, gpa(p.k_e.value), p.k_e.err.map(gpa)));
-            let name = match &pts[0].key.indenter {
-                Some(ball) => format!("{material} @ {ball}"),
-                None => material.to_string(),
-            };
-            k_e.series.insert(name, ke.collect());
-        }
     }
-    // Energy per cycle (load histories), in μJ; with a wear law, the worn
-    // volume over the path, in µm³; with [stress], the largest von Mises
-    // stress over p_H: one panel per material each.
-    let uj = |v: f64| v * 1e6;
-    let energy = panels_of(
-        points,
-        "energy per cycle",
-        "dissipated per cycle (μJ)",
-        |p| {
-            let d = p.dissipated.as_ref()?;
-            Some((uj(d.value), d.err.map(uj)))
-        },
-    );
-    let worn = panels_of(
-        points,
-        "worn volume",
-        "worn volume over the path (μm³)",
-        |p| Some((p.wear?.0 * 1e18, None)),
-    );
+    let k_e = panels_of(points, "K_E(ψ), flat-surface calibration", "", |p| {
+        p.flat_calibration.then_some((p.k_e.value, p.k_e.err))
+    });
+    // Energy per cycle (load histories); with a wear law, the worn volume
+    // over the path; with [stress], the largest von Mises stress over p_H:
+    // one panel per material each.
+    let energy = panels_of(points, "energy per cycle", "", |p| {
+        let d = p.dissipated.as_ref()?;
+        Some((d.value, d.err))
+    });
+    let worn = panels_of(points, "worn volume", "", |p| Some((p.wear?.0, None)));
     let stress = panels_of(
         points,
         "largest von Mises stress",
@@ -714,9 +711,9 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint], missing: &[CaseKey]) -> a
             Some((l.over_p_h, None))
         },
     );
-    // On a surface with a hardness: the area at the cap, in mm².
-    let plastic = panels_of(points, "area at the hardness", "plastic area (mm²)", |p| {
-        Some((p.plastic?.plastic_area_m2 * 1e6, None))
+    // On a surface with a hardness: the area at the cap.
+    let plastic = panels_of(points, "area at the hardness", "", |p| {
+        Some((p.plastic?.plastic_area_m2, None))
     });
     for key in missing {
         let panel = by_material
@@ -727,13 +724,11 @@ pub fn plot_curves(path: &Path, points: &[CurvePoint], missing: &[CaseKey]) -> a
         panel.missing.entry(label).or_default().push(key.angle_deg);
     }
     let mut panels: Vec<Panel> = by_material.into_values().collect();
-    panels.extend(energy);
-    panels.extend(worn);
-    panels.extend(plastic);
+    panels.extend(in_unit(energy, "dissipated per cycle", "J", 1));
+    panels.extend(in_unit(worn, "worn volume over the path", "m", 3));
+    panels.extend(in_unit(plastic, "plastic area", "m", 2));
     panels.extend(stress);
-    if !k_e.series.is_empty() {
-        panels.push(k_e);
-    }
+    panels.extend(in_unit(k_e, "K_E", "Pa", 1));
     let layout = Panels {
         count: panels.len(),
         legend: 180,
@@ -811,13 +806,7 @@ impl Figure for Curves {
                 // angles missing, so that one never hides another.
                 (lo - pad * (1.0 + 0.6 * panel.missing.len().saturating_sub(1) as f64))..(hi + pad),
             )?;
-            chart
-                .configure_mesh()
-                .x_desc("force angle ψ (deg)")
-                .y_desc(panel.y_desc)
-                .x_label_formatter(&|x| format!("{x:.0}"))
-                .draw()
-                .map_err(err)?;
+            plot::axes(&mut chart, "force angle ψ (deg)", &panel.y_desc, true)?;
             for (name, pts) in &panel.series {
                 let (color, marker) = style_of(name);
                 let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();

@@ -12,7 +12,7 @@ use solver::{Grid, HistoryOutput, WearCycle};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::plot::{self, err, Area, Figure, Frame, PALETTE};
+use super::plot::{self, err, Area, Figure, Frame, Unit, PALETTE};
 
 /// Header of `wear.csv`.
 pub const WEAR_HEADER: &str = "cycle,physical_cycles,worn_volume_m3,worn_volume_per_cycle_m3,depth_max_m,depth_max_x_m,depth_max_y_m,depth_increment_max_m,scar_area_m2,scar_extent_x_m,scar_extent_y_m,contact_radius_m,stick_radius_m,force_amplitude_n,shift_amplitude_m,dissipated_j,regime,worn_through_cells,ball_worn_volume_m3,ball_depth_max_m";
@@ -87,8 +87,8 @@ pub fn profiles_csv(h: &HistoryOutput, grid: &Grid) -> String {
     out
 }
 
-/// A saved cycle's profiles as drawn: its label, then (position, surface)
-/// along x and along y, in µm with the depth negative.
+/// A saved cycle's profiles: its label, then (position, surface) along x
+/// and along y, in m with the depth negative.
 type ProfileLine = (String, Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 /// The profiles as drawn.
@@ -101,7 +101,7 @@ fn profile_lines(h: &HistoryOutput, grid: &Grid) -> Vec<ProfileLine> {
     let line = |p: &[f64]| -> Vec<(f64, f64)> {
         p.iter()
             .enumerate()
-            .map(|(i, &d)| (grid.x(i) * 1e6, -d * 1e6))
+            .map(|(i, &d)| (grid.x(i), -d))
             .collect()
     };
     saved(h)
@@ -112,6 +112,9 @@ fn profile_lines(h: &HistoryOutput, grid: &Grid) -> Vec<ProfileLine> {
         })
         .collect()
 }
+
+/// Width of the legend column beside the profiles.
+const LEGEND: u32 = 170;
 
 impl Figure for Profiles<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<()> {
@@ -126,13 +129,20 @@ impl Figure for Profiles<'_> {
             ylo = ylo.min(y);
         }
         if !xlo.is_finite() || xhi <= xlo {
-            (xlo, xhi) = (-1.0, 1.0);
+            (xlo, xhi) = (-1e-6, 1e-6);
         }
         if ylo >= 0.0 {
-            ylo = -1e-6;
+            ylo = -1e-12;
         }
+        // Positions in µm, depths in the unit that makes the deepest read
+        // 1–1000 (a scar of 2e-9 m reads 2 nm, not 0.002 µm).
+        let ux = Unit::for_largest("m", 1, xlo.abs().max(xhi.abs()));
+        let uy = Unit::for_largest("m", 1, ylo);
+        let (xlo, xhi, ylo) = (xlo * ux.factor, xhi * ux.factor, ylo * uy.factor);
         let yp = -ylo * 0.08;
-        let panels = root.split_evenly((1, 2));
+        // The legend in its own column: inside a panel it covered the scar.
+        let (plots, legend) = root.split_horizontally(root.dim_in_pixel().0 - LEGEND);
+        let panels = plots.split_evenly((1, 2));
         let frame = Frame {
             title: 16,
             margin: 12,
@@ -146,20 +156,30 @@ impl Figure for Profiles<'_> {
                 xlo..xhi,
                 (ylo - yp)..yp,
             )?;
-            chart
-                .configure_mesh()
-                .x_desc(format!("{} through the centre (μm)", ["x", "y"][k]))
-                .y_desc("surface (μm, worn depth below 0)")
-                .draw()
-                .map_err(err)?;
-            for (j, (label, x, y)) in self.lines.iter().enumerate() {
+            plot::axes(
+                &mut chart,
+                &format!("{} through the centre ({})", ["x", "y"][k], ux.text),
+                &format!("surface ({}, worn depth below 0)", uy.text),
+                true,
+            )?;
+            for (j, (_, x, y)) in self.lines.iter().enumerate() {
                 let colour = PALETTE[j % PALETTE.len()];
-                let line = if k == 0 { x } else { y };
-                plot::labelled_line(&mut chart, line, colour, label)?;
+                let line: Vec<(f64, f64)> = if k == 0 { x } else { y }
+                    .iter()
+                    .map(|&(p, d)| (p * ux.factor, d * uy.factor))
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(line, colour.stroke_width(2)))
+                    .map_err(err)?;
             }
-            plot::legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         }
-        Ok(())
+        let entries: Vec<(String, RGBColor, u32)> = self
+            .lines
+            .iter()
+            .enumerate()
+            .map(|(j, (label, _, _))| (label.clone(), PALETTE[j % PALETTE.len()], 2))
+            .collect();
+        plot::line_legend(&legend, &entries)
     }
 }
 
@@ -183,7 +203,7 @@ pub fn write_wear(dir: &Path, h: &HistoryOutput, grid: &Grid, title: &str) -> Re
     };
     let mut warnings = Vec::new();
     for name in ["wear_profiles.png", "wear_profiles.svg"] {
-        if let Err(e) = plot::write(&dir.join(name), (1200, 480), &figure) {
+        if let Err(e) = plot::write(&dir.join(name), (1200 + LEGEND, 480), &figure) {
             warnings.push(format!("{name}: {e:#}"));
         }
     }

@@ -53,10 +53,13 @@ pub fn unix_ns() -> u64 {
 }
 
 /// A run stopped by Ctrl-C or SIGTERM (typed, so that the Python module can
-/// raise `KeyboardInterrupt` for it).
+/// raise `KeyboardInterrupt` for it), naming the caller's way to resume.
 #[derive(Debug, thiserror::Error)]
-#[error("interrupted; the journal keeps what was recorded (use --resume)")]
-pub struct Interrupted;
+#[error("interrupted; the journal keeps what was recorded (continue with {resume})")]
+pub struct Interrupted {
+    /// The option that continues the run (`--resume`, `resume=True`).
+    pub resume: &'static str,
+}
 
 /// What a step of [`Exchange::wait_loop`] asks for next.
 pub enum Next {
@@ -75,11 +78,17 @@ pub struct Exchange<'a> {
     server: Server<ipc::Service, [u8], (), [u8], ()>,
     listener: Listener<ipc::Service>,
     notifier: Notifier<ipc::Service>,
+    names: super::OptionNames,
 }
 
 impl<'a> Exchange<'a> {
-    /// Create the node and services of run `run_id`, sized for `workers`.
-    pub fn open(run_id: &'a str, workers: usize) -> anyhow::Result<Self> {
+    /// Create the node and services of run `run_id`, sized for `workers`;
+    /// an interruption names the caller's options (`names`).
+    pub fn open(
+        run_id: &'a str,
+        workers: usize,
+        names: super::OptionNames,
+    ) -> anyhow::Result<Self> {
         let cfg = protocol::ipc_config()?;
         let node = protocol::create_node(
             &cfg,
@@ -115,6 +124,7 @@ impl<'a> Exchange<'a> {
             server,
             listener,
             notifier,
+            names,
         })
     }
 
@@ -152,7 +162,12 @@ impl<'a> Exchange<'a> {
             match waitset
                 .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, within)
             {
-                Ok(WaitSetRunResult::TerminationRequest) => return Err(Interrupted.into()),
+                Ok(WaitSetRunResult::TerminationRequest) => {
+                    return Err(Interrupted {
+                        resume: self.names.resume,
+                    }
+                    .into())
+                }
                 // Any other signal cut the wait short: SIGCONT after a pause
                 // (Ctrl-Z and `fg`, a debugger, `scontrol suspend`/`resume`)
                 // ended a sweep here (#33 item 4). Not a request to stop: go

@@ -156,19 +156,25 @@ pub(crate) fn first_difference(a: &str, b: &str) -> String {
 impl Journal {
     /// Start a new journal (fails when one exists and `resume` is false), or
     /// reopen an existing one for `--resume`, checking that it was written
-    /// for the same config and dropping a torn last line.
+    /// for the same config and dropping a torn last line. Refusals name the
+    /// caller's options (`names`: the CLI's flags or Python's keywords).
     pub fn open(
         out_dir: &Path,
         run_id: &str,
         config: &str,
         resume: bool,
+        names: super::OptionNames,
     ) -> anyhow::Result<(Journal, Previous)> {
+        let super::OptionNames {
+            resume: resume_opt,
+            out: out_opt,
+        } = names;
         let path = out_dir.join(JOURNAL_FILE);
         let mut prev = Previous::default();
         if path.exists() {
             if !resume {
                 bail!(
-                    "{} already holds a sweep ({}); use --resume to continue it or another --out",
+                    "{} already holds a sweep ({}); use {resume_opt} to continue it or another {out_opt}",
                     out_dir.display(),
                     JOURNAL_FILE
                 );
@@ -181,7 +187,7 @@ impl Journal {
             let n = text.len().min(HEADER_START.len());
             if text[..n] != HEADER_START.as_bytes()[..n] {
                 bail!(
-                    "--resume refused: {} is not an mpcontact journal (it does not start with {HEADER_START}); move it away or choose another --out",
+                    "{resume_opt} refused: {} is not an mpcontact journal (it does not start with {HEADER_START}); move it away or choose another {out_opt}",
                     path.display()
                 );
             }
@@ -203,7 +209,7 @@ impl Journal {
                         check_version(&path, protocol_version).context("--resume refused")?;
                         if old_cfg != config {
                             bail!(
-                                "--resume refused: {} was written for a different config ({})",
+                                "{resume_opt} refused: {} was written for a different config ({})",
                                 path.display(),
                                 first_difference(&old_cfg, config)
                             );
@@ -309,6 +315,7 @@ impl Journal {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::OptionNames;
 
     fn tmp(name: &str) -> tempfile::TempDir {
         // Removed when dropped: tests leave nothing in the system temp dir.
@@ -338,7 +345,7 @@ mod tests {
         let tmp_dir = tmp("torn");
         let d = tmp_dir.path().to_path_buf();
         {
-            let (mut j, prev) = Journal::open(&d, "r1", "cfg", false).unwrap();
+            let (mut j, prev) = Journal::open(&d, "r1", "cfg", false, OptionNames::CLI).unwrap();
             assert!(prev.entries.is_empty());
             j.append(&Line::Case(Box::new(rec("a")))).unwrap();
             j.append(&Line::Case(Box::new(rec("b")))).unwrap();
@@ -347,11 +354,24 @@ mod tests {
         let mut text = std::fs::read_to_string(&p).unwrap();
         text.push_str("{\"kind\":\"case\",\"case_id\":\"c\"");
         std::fs::write(&p, text).unwrap();
+        let refusal = |names| {
+            format!(
+                "{:#}",
+                Journal::open(&d, "r2", "cfg", false, names).err().unwrap()
+            )
+        };
+        let cli = refusal(OptionNames::CLI);
         assert!(
-            Journal::open(&d, "r2", "cfg", false).is_err(),
-            "needs --resume"
+            cli.contains("use --resume to continue it or another --out"),
+            "{cli}"
         );
-        let (mut j, prev) = Journal::open(&d, "r2", "cfg", true).unwrap();
+        // Python's `run` names its own keywords, not the CLI's flags.
+        let python = refusal(OptionNames::PYTHON);
+        assert!(
+            python.contains("use resume=True to continue it or another out="),
+            "{python}"
+        );
+        let (mut j, prev) = Journal::open(&d, "r2", "cfg", true, OptionNames::CLI).unwrap();
         assert!(prev.torn_tail);
         assert_eq!(prev.entries.len(), 2);
         assert_eq!(prev.entries[1], rec("b"));
@@ -366,7 +386,12 @@ mod tests {
         let p = d.join(JOURNAL_FILE);
         for foreign in ["my notes, no newline", "{\"kind\":\"case\"}\n", "x"] {
             std::fs::write(&p, foreign).unwrap();
-            let e = format!("{:#}", Journal::open(&d, "r", "cfg", true).err().unwrap());
+            let e = format!(
+                "{:#}",
+                Journal::open(&d, "r", "cfg", true, OptionNames::CLI)
+                    .err()
+                    .unwrap()
+            );
             assert!(e.contains("not an mpcontact journal"), "{e}");
             assert_eq!(
                 std::fs::read_to_string(&p).unwrap(),
@@ -376,7 +401,7 @@ mod tests {
         }
         // A header torn while being written is ours: resumed afresh.
         std::fs::write(&p, "{\"kind\":\"hea").unwrap();
-        let (_, prev) = Journal::open(&d, "r", "cfg", true).unwrap();
+        let (_, prev) = Journal::open(&d, "r", "cfg", true, OptionNames::CLI).unwrap();
         assert!(prev.torn_tail && prev.entries.is_empty());
     }
 
@@ -407,8 +432,8 @@ mod tests {
     fn resume_with_other_config_is_refused_naming_the_line() {
         let tmp_dir = tmp("cfg");
         let d = tmp_dir.path().to_path_buf();
-        drop(Journal::open(&d, "r1", "a = 1\nb = 2\n", false).unwrap());
-        let err = Journal::open(&d, "r2", "a = 1\nb = 3\n", true)
+        drop(Journal::open(&d, "r1", "a = 1\nb = 2\n", false, OptionNames::CLI).unwrap());
+        let err = Journal::open(&d, "r2", "a = 1\nb = 3\n", true, OptionNames::CLI)
             .err()
             .unwrap()
             .to_string();

@@ -64,6 +64,33 @@ pub struct RunArgs {
     pub exe: WorkerCommand,
     /// Run only this shard of the cases (`--shard K/N`).
     pub shard: Option<crate::shard::Shard>,
+    /// How the caller spells its options in messages ([`OptionNames::CLI`]
+    /// or [`OptionNames::PYTHON`]).
+    pub names: OptionNames,
+}
+
+/// How the caller spells the options a message points to: the CLI's flags
+/// or Python's keywords, so that `mpcontact.run` does not tell a Python
+/// user to pass `--resume`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OptionNames {
+    /// The option that continues a journalled sweep.
+    pub resume: &'static str,
+    /// The option that chooses the output directory.
+    pub out: &'static str,
+}
+
+impl OptionNames {
+    /// `mpcontact run`'s flags.
+    pub const CLI: OptionNames = OptionNames {
+        resume: "--resume",
+        out: "--out",
+    };
+    /// `mpcontact.run`'s keywords.
+    pub const PYTHON: OptionNames = OptionNames {
+        resume: "resume=True",
+        out: "out=",
+    };
 }
 
 fn new_run_id() -> String {
@@ -87,7 +114,8 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         .unwrap_or(0.0);
     if args.out_dir.exists() && !args.out_dir.is_dir() {
         anyhow::bail!(
-            "--out {}: exists and is not a directory",
+            "{} {}: exists and is not a directory",
+            args.names.out,
             args.out_dir.display()
         );
     }
@@ -126,9 +154,19 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         args.workers,
         crate::memory::available_bytes(),
     )?;
+    // The first moments of every case, before the journal is written: a
+    // case a solve would refuse at once (a contact at the domain's edge)
+    // refuses the sweep, as `check` does. A resumed sweep passed them when
+    // it began. The kernels built here are stored for the workers.
+    if !args.resume {
+        crate::preflight::check(
+            plan.cases.iter().map(|c| (&c.key, &c.spec)),
+            crate::preflight::Kernels::Store,
+        )?;
+    }
     let raw = args.config.to_toml();
     let (mut recorder, resumed) =
-        record::Recorder::open(plan, &args.out_dir, &run_id, &raw, args.resume)?;
+        record::Recorder::open(plan, &args.out_dir, &run_id, &raw, args.resume, args.names)?;
     let total = recorder.plan().cases.len();
     let progress = progress::Progress::new(args.quiet, total, resumed.cases);
     if resumed.torn_tail {
@@ -148,7 +186,7 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
     let remaining = recorder.plan().remaining();
     if remaining > 0 {
         let workers = args.workers.max(1).min(remaining);
-        let exchange = exchange::Exchange::open(&run_id, workers)?;
+        let exchange = exchange::Exchange::open(&run_id, workers, args.names)?;
         let mut supervisor = supervise::Supervisor::new(supervise::SuperviseArgs {
             run_id: &run_id,
             exe: &args.exe,

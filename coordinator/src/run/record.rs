@@ -42,8 +42,9 @@ impl Recorder {
         run_id: &str,
         config: &str,
         resume: bool,
+        names: super::OptionNames,
     ) -> anyhow::Result<(Recorder, Resumed)> {
-        let (journal, previous) = Journal::open(out_dir, run_id, config, resume)?;
+        let (journal, previous) = Journal::open(out_dir, run_id, config, resume, names)?;
         let mut outcomes: Vec<Option<Outcome>> = vec![None; plan.cases.len()];
         for entry in previous.entries {
             let i = match &entry.key {
@@ -174,14 +175,16 @@ mod tests {
     fn a_case_is_recorded_once_and_resumes_by_key() {
         let tmp_dir = tmp("once");
         let d = tmp_dir.path().to_path_buf();
-        let (mut rec, resumed) = Recorder::open(plan(), &d, "r1", "cfg", false).unwrap();
+        let (mut rec, resumed) =
+            Recorder::open(plan(), &d, "r1", "cfg", false, crate::run::OptionNames::CLI).unwrap();
         assert_eq!(resumed.cases, 0);
         rec.dispatched(1, 0);
         assert!(rec.record(1, ok(0)).unwrap().is_some());
         assert!(rec.record(1, ok(7)).unwrap().is_none(), "recorded twice");
         assert_eq!(rec.recorded(), 1);
         drop(rec);
-        let (rec, resumed) = Recorder::open(plan(), &d, "r2", "cfg", true).unwrap();
+        let (rec, resumed) =
+            Recorder::open(plan(), &d, "r2", "cfg", true, crate::run::OptionNames::CLI).unwrap();
         assert_eq!(resumed.cases, 1);
         assert_eq!(rec.plan().remaining(), 1);
         let (cases, outcomes) = rec.results();
@@ -194,13 +197,14 @@ mod tests {
     fn an_old_journal_resumes_by_display_text() {
         let tmp_dir = tmp("old");
         let d = tmp_dir.path().to_path_buf();
-        drop(Recorder::open(plan(), &d, "r1", "cfg", false).unwrap());
+        drop(Recorder::open(plan(), &d, "r1", "cfg", false, crate::run::OptionNames::CLI).unwrap());
         let old = "{\"kind\":\"case\",\"case_id\":\"Cu/flat/015.0\",\"status\":\"not-converged\",\
                    \"error\":null,\"worker\":1,\"seconds\":0.5,\"kernel_builds\":1,\"scalars\":null}\n";
         let path = d.join(super::super::journal::JOURNAL_FILE);
         let text = std::fs::read_to_string(&path).unwrap() + old;
         std::fs::write(&path, text).unwrap();
-        let (rec, resumed) = Recorder::open(plan(), &d, "r2", "cfg", true).unwrap();
+        let (rec, resumed) =
+            Recorder::open(plan(), &d, "r2", "cfg", true, crate::run::OptionNames::CLI).unwrap();
         assert_eq!(resumed.cases, 1);
         let (_, outcomes) = rec.results();
         assert_eq!(outcomes[1].as_ref().unwrap().status, Status::NotConverged);
@@ -210,7 +214,8 @@ mod tests {
     fn non_finite_scalars_are_recorded_as_failed() {
         let tmp_dir = tmp("nan");
         let d = tmp_dir.path().to_path_buf();
-        let (mut rec, _) = Recorder::open(plan(), &d, "r1", "cfg", false).unwrap();
+        let (mut rec, _) =
+            Recorder::open(plan(), &d, "r1", "cfg", false, crate::run::OptionNames::CLI).unwrap();
         let mut bad = ok(0);
         if let Some(s) = bad.scalars.as_mut() {
             s.p_max_pa = f64::NAN;
