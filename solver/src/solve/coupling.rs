@@ -193,7 +193,7 @@ pub(crate) struct Step<'a> {
     /// The coupling loop's tolerance for this step (the relative change of
     /// the pressure between passes): the configured one, or a looser one
     /// for an increment inside a load path's segment (see
-    /// `history::INTERIOR_COUPLING`).
+    /// `history::walk::INTERIOR_COUPLING`).
     pub coupling_tolerance: f64,
     /// The tangential solves' KKT tolerance for this step (before
     /// `tolerance_scale`): the configured one, or a looser one inside a

@@ -4,7 +4,7 @@
 //! point under a cell moves by its slip δt − u, zero in the stick zone),
 //! the increment's wear taken explicitly or, with a cycle jump,
 //! implicitly in the pressure (a compliant layer on the normal solve), and
-//! the record of every simulated cycle. `history.rs` drives it; it knows
+//! the record of every simulated cycle. `history` drives it; it knows
 //! no solver.
 
 use serde::{Deserialize, Serialize};
