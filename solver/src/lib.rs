@@ -93,11 +93,11 @@ pub use operators::operator;
 pub use operators::stress;
 pub use post::indentation;
 pub use post::stress_summary;
-pub use solve::coarse_slip;
 pub use solve::normal;
 pub use solve::tangential;
-pub use solve::tangential_displacement;
-pub use solve::window;
+pub use solve::tangential::coarse_slip;
+pub use solve::tangential::displacement as tangential_displacement;
+pub use solve::tangential::window;
 
 pub use base::grid::Grid;
 pub use base::parallel::Threads;

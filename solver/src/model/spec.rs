@@ -59,7 +59,7 @@ pub enum TangentialMethod {
     #[default]
     #[serde(rename = "cg")]
     ConjugateGradient,
-    /// The active-set iteration of `crate::solve::active_set`: inner PCG
+    /// The active-set iteration of `crate::solve::tangential::active_set`: inner PCG
     /// on a frozen stick/slip split with the inverse of the compliance's
     /// circulant embedding as preconditioner (issue #48).
     #[serde(rename = "active-set")]

@@ -12,10 +12,10 @@ use crate::model::spec::CaseSpec;
 use crate::operators::operator::{X, Y, Z};
 use crate::solve::normal::{NormalProblem, NormalReport, NormalSolution};
 use crate::solve::resident::Resident;
+use crate::solve::tangential::displacement::DisplacementProblem;
 use crate::solve::tangential::{
     TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
 };
-use crate::solve::tangential_displacement::DisplacementProblem;
 
 /// History depth of the Anderson mixing of the coupling loop.
 const ANDERSON_DEPTH: usize = 3;

@@ -13,10 +13,10 @@ use crate::operators::operator::Operator;
 use crate::solve::normal::{
     solve_normal, solve_normal_from_rest, NormalCache, NormalProblem, NormalSolution,
 };
+use crate::solve::tangential::window::WindowCache;
 use crate::solve::tangential::{
     solve_tangential, solve_tangential_taking, TangentialProblem, TangentialSolution,
 };
-use crate::solve::window::WindowCache;
 
 /// What a process keeps per kernel: the DC-FFT operator and the caches the
 /// solvers made for it (the normal solver's coarse levels and
@@ -64,13 +64,13 @@ impl Resident {
         solve_normal_from_rest(&mut self.operator, &mut self.normal, prob)
     }
 
-    /// [`crate::solve::tangential_displacement::solve_displacement`] on this bundle.
+    /// [`crate::solve::tangential::displacement::solve_displacement`] on this bundle.
     pub fn solve_displacement(
         &mut self,
-        prob: &crate::solve::tangential_displacement::DisplacementProblem,
+        prob: &crate::solve::tangential::displacement::DisplacementProblem,
     ) -> Result<TangentialSolution, SolverError> {
         crate::base::progress::stage(Stage::Tangential);
-        crate::solve::tangential_displacement::solve_displacement(
+        crate::solve::tangential::displacement::solve_displacement(
             &mut self.operator,
             &mut self.windows,
             prob,

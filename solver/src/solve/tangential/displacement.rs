@@ -4,7 +4,7 @@
 //! `|q_i| ≤ μ p_i` per cell and no condition on their sum, which is the
 //! result (the tangential force). Sees only the operator's tangential block
 //! and an extra slip term supplied by the caller, as the force-controlled
-//! solver ([`crate::solve::tangential`]) does.
+//! solver ([`crate::solve::tangential::force`]) does.
 //!
 //! Method: the convex problem min ½qᵀCq + (e − δt)ᵀq over the discs, whose
 //! gradient is the slip `s = Cq + e − δt`, by accelerated projected gradient
@@ -16,9 +16,9 @@
 
 use crate::error::SolverError;
 use crate::operators::operator::Operator;
-use crate::solve::fista::{self, Momentum};
-use crate::solve::tangential_problem::{TangentialReport, TangentialSolution, TangentialStart};
-use crate::solve::window::{contact_window, WindowCache};
+use crate::solve::tangential::fista::{self, Momentum};
+use crate::solve::tangential::problem::{TangentialReport, TangentialSolution, TangentialStart};
+use crate::solve::tangential::window::{contact_window, WindowCache};
 
 /// Inputs of a displacement-controlled tangential solve.
 #[derive(Clone, Copy, Debug)]

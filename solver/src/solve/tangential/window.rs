@@ -5,7 +5,7 @@
 //! conditions.
 
 use crate::operators::operator::Operator;
-use crate::solve::coarse_slip::TangentialLevels;
+use crate::solve::tangential::coarse_slip::TangentialLevels;
 
 /// A square `n x n` window of an `N x N` grid, its first cell at column `x0`, row `y0`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -16,7 +16,7 @@ use crate::base::grid::Grid;
 use crate::error::SolverError;
 use crate::operators::multilevel::{coarse_table, prolong, restrict, FourierPrecond};
 use crate::operators::operator::{Operator, X, Y};
-use crate::solve::tangential_problem::{TangentialProblem, TangentialSolution, TangentialStart};
+use crate::solve::tangential::problem::{TangentialProblem, TangentialSolution, TangentialStart};
 
 /// Smallest grid that is still coarsened further (as the normal solver's levels).
 const MIN_COARSE_N: usize = 32;
