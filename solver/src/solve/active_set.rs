@@ -41,7 +41,7 @@
 //!   change; the last run goes to the tolerance.
 //! * **Projection guess:** before the first PCG, stick cells that the force
 //!   shift put over their bounds become slip cells.
-//! * **Without the force condition** ([`active_set_shift`], displacement
+//! * **Without the force condition** ([`Condition::Shift`], displacement
 //!   control): `δ` is imposed (the caller folds it into `e`, so the slip is
 //!   measured from it) and `Σ q` is free. The frozen system is then SPD on
 //!   the whole space, the PCG runs with `M` alone (no deflation, no `P_M`,
@@ -654,12 +654,23 @@ pub(crate) fn slip_field(
     }
 }
 
-/// Solves the partial-slip problem of `set` from the feasible tractions `q`
-/// (a start whose cells on their rims are its slip cells), leaving the
-/// solution in `q` and its slip field `C q + e` in `s`. Returns with
-/// `converged` false when the budget or [`MAX_OUTER`] outer updates run out,
-/// or no stick cell is left; the caller's projected-gradient phase then
-/// continues from `q`.
+/// What the iteration holds besides the friction discs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Condition {
+    /// `Σ q = set.target` (force control): `δ`, the stick cells' mean slip,
+    /// is its multiplier; the start's slip is computed here.
+    Force,
+    /// Nothing more (displacement control): `δ` is imposed, folded by the
+    /// caller into `e` (negated), so stick cells' slip `C q + e` must
+    /// vanish; `set.target` is not read; `ctl.floor` is the measure's scale
+    /// (the caller's `max(|δ|, floor)`); `s` holds the start's slip on entry
+    /// (the caller computed it to choose the start); the returned `shift`
+    /// is zero.
+    Shift,
+}
+
+/// Solves the force-controlled partial-slip problem of `set`:
+/// [`active_set_under`] with [`Condition::Force`].
 pub(crate) fn active_set(
     op: &mut Operator,
     extra: Option<(&[f64], &[f64])>,
@@ -668,36 +679,20 @@ pub(crate) fn active_set(
     q: (&mut [f64], &mut [f64]),
     s: (&mut [f64], &mut [f64]),
 ) -> Result<Outcome, SolverError> {
-    iterate(op, extra, set, true, ctl, q, s)
+    active_set_under(op, extra, set, Condition::Force, ctl, q, s)
 }
 
-/// [`active_set`] without the force condition (displacement control): the
-/// tractions of `set`'s discs (its `target` is not read) whose slip `C q +
-/// e` vanishes on stick cells and opposes them on slip cells, `e` carrying
-/// the imposed shift, negated. `s` holds the start's slip `C q + e` on
-/// entry (the caller computed it to choose the start). `ctl.floor` is the
-/// measure's scale (`max(|δ|, floor)` of the caller: `δ` is not a result
-/// here). Returns with `converged` false when the budget or [`MAX_OUTER`]
-/// outer updates run out; the caller's projected-gradient phase then
-/// continues from `q`. The returned `shift` is zero.
-pub(crate) fn active_set_shift(
+/// Solves the partial-slip problem of `set` under `condition` from the
+/// feasible tractions `q` (a start whose cells on their rims are its slip
+/// cells), leaving the solution in `q` and its slip field `C q + e` in `s`.
+/// Returns with `converged` false when the budget or [`MAX_OUTER`] outer
+/// updates run out, or (force control) no stick cell is left; the caller's
+/// projected-gradient phase then continues from `q`.
+pub(crate) fn active_set_under(
     op: &mut Operator,
     extra: Option<(&[f64], &[f64])>,
     set: &Feasible,
-    ctl: Controls,
-    q: (&mut [f64], &mut [f64]),
-    s: (&mut [f64], &mut [f64]),
-) -> Result<Outcome, SolverError> {
-    iterate(op, extra, set, false, ctl, q, s)
-}
-
-/// The iteration of [`active_set`] (`force`: the start's slip is computed
-/// here) and [`active_set_shift`].
-fn iterate(
-    op: &mut Operator,
-    extra: Option<(&[f64], &[f64])>,
-    set: &Feasible,
-    force: bool,
+    condition: Condition,
     ctl: Controls,
     (qx, qy): (&mut [f64], &mut [f64]),
     (sx, sy): (&mut [f64], &mut [f64]),
@@ -707,6 +702,7 @@ fn iterate(
     let z = || vec![0.0; len];
     let mut cut = op.extra_diagonal().unwrap_or_default();
     cut.sort_unstable_by_key(|&(c, _)| c);
+    let force = condition == Condition::Force;
     let mut w = Work {
         set,
         force,

@@ -9,20 +9,23 @@
 //! Method: the convex problem min ½qᵀCq + (e − δt)ᵀq over the discs, whose
 //! gradient is the slip `s = Cq + e − δt`. It is the force-controlled
 //! problem without its load constraint, so it is solved by the same
-//! active-set iteration with the circulant-inverse preconditioner
-//! ([`crate::solve::active_set::active_set_shift`]: one constraint fewer, no
-//! multiplier), and, if that stops short, by accelerated projected gradient
-//! (FISTA with gradient-based adaptive restart, the projection a clip per
-//! cell) from where it stopped. Stick cells end with zero slip, slip cells
-//! with the traction on their rim opposing the slip. When the imposed shift
-//! exceeds what the stick zone can hold, no stick cell is left and every
-//! traction sits on its rim: gross slip, F = μP on a flat Coulomb surface,
-//! solved by the same iteration on a split without stick cells.
+//! active-set iteration with the circulant-inverse preconditioner, one
+//! constraint fewer and no multiplier
+//! ([`crate::solve::active_set::active_set_under`] with
+//! `Condition::Shift`), from a start moved along the shift when it does not
+//! yet carry it ([`shift_guess`]); if that stops short, accelerated
+//! projected gradient (FISTA with gradient-based adaptive restart, the
+//! projection a clip per cell) continues from where it stopped. Stick cells
+//! end with zero slip, slip cells with the traction on their rim opposing
+//! the slip. When the imposed shift exceeds what the stick zone can hold,
+//! no stick cell is left and every traction sits on its rim: gross slip,
+//! F = μP on a flat Coulomb surface, solved by the same iteration on a
+//! split without stick cells.
 
 use crate::base::parallel::Chunks;
 use crate::error::SolverError;
 use crate::operators::operator::Operator;
-use crate::solve::active_set::{active_set_shift, slip_field, Controls, Feasible};
+use crate::solve::active_set::{active_set_under, slip_field, Condition, Controls, Feasible};
 use crate::solve::fista::{self, Momentum};
 use crate::solve::tangential_problem::{TangentialReport, TangentialSolution, TangentialStart};
 use crate::solve::window::{contact_window, WindowCache};
@@ -229,7 +232,16 @@ pub fn solve_displacement_on_grid(
         floor: scale,
         budget: prob.max_iterations,
     };
-    let out = active_set_shift(op, extra, &set, ctl, (&mut qx, &mut qy), (&mut sx, &mut sy))?;
+    let q = (&mut qx[..], &mut qy[..]);
+    let out = active_set_under(
+        op,
+        extra,
+        &set,
+        Condition::Shift,
+        ctl,
+        q,
+        (&mut sx, &mut sy),
+    )?;
     let mut report = TangentialReport {
         iterations: out.iterations,
         cg_iterations: out.iterations,
