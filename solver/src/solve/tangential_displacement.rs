@@ -126,10 +126,10 @@ const GUESS: f64 = 0.5;
 /// shift makes slip start on their rims in its direction, where the
 /// force-controlled solver's projection of a new force puts them. Returns
 /// `None` when the start is left as it is (no energy product spent), else
-/// `t` (0 if `dᵀCd` vanished and nothing moved). (Table 1a at 128², 2
-/// cycles, a whole segment as one increment: Δ = 0.2 µm 132 → 78
-/// iterations, Δ = 0.4 µm (gross slip: a reversal from a plateau turns
-/// every rim) 113 → 21; 10 increments per segment within ±5 %.)
+/// `t` (0 if `dᵀCd` vanished and nothing moved). (Table 1a at 128² of 2
+/// µm, 2 cycles, uncoupled, a whole segment as one increment: Δ = 0.2 µm
+/// 164 → 85 iterations, Δ = 0.4 µm (gross slip: a reversal from a plateau
+/// turns every rim) 179 → 21; 10 increments per segment −5 % to +1 %.)
 fn shift_guess(
     op: &mut Operator,
     cells: &[usize],
