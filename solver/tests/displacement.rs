@@ -258,3 +258,192 @@ fn transition_to_gross_slip_at_delta_star_with_energy_ratio_one_fifth() {
     );
     assert!((ratio / 0.2 - 1.0).abs() < 0.02, "A = {ratio}");
 }
+
+/// The KKT residuals of a displacement-controlled solution, recomputed with
+/// the whole grid's operator (the solver runs on a contact window): the
+/// largest excess of a traction over its disc `|q|/μp − 1`, and relative to
+/// `|δ|` the largest stick-cell slip `|C q + e − δ|` and slip-cell
+/// misalignment `|w + |w| q/|q||` (`w` the slip: zero when the traction
+/// opposes it), and the largest traction outside the contact.
+fn kkt_on_grid(
+    op: &mut solver::operator::Operator,
+    p: &[f64],
+    sol: &solver::tangential::TangentialSolution,
+    shift: [f64; 2],
+    extra: Option<(&[f64], &[f64])>,
+) -> [f64; 4] {
+    let n = p.len();
+    let (mut sx, mut sy) = (vec![0.0; n], vec![0.0; n]);
+    op.tangential(&sol.qx, &sol.qy, &mut sx, &mut sy);
+    let scale = shift[0].hypot(shift[1]);
+    let mut r = [0.0_f64; 4];
+    for i in 0..n {
+        let (qx, qy) = (sol.qx[i], sol.qy[i]);
+        let q = qx.hypot(qy);
+        if p[i] <= 0.0 {
+            r[3] = r[3].max(q);
+            continue;
+        }
+        let (ex, ey) = extra.map_or((0.0, 0.0), |(x, y)| (x[i], y[i]));
+        let (wx, wy) = (sx[i] + ex - shift[0], sy[i] + ey - shift[1]);
+        let b = MU * p[i];
+        r[0] = r[0].max(q / b - 1.0);
+        if q < (1.0 - 1e-9) * b {
+            r[1] = r[1].max(wx.hypot(wy) / scale);
+        } else {
+            let w = wx.hypot(wy);
+            r[2] = r[2].max((wx + w * qx / q).hypot(wy + w * qy / q) / scale);
+        }
+    }
+    r
+}
+
+/// The previous state's displacement, negated: the extra term of an
+/// increment from `sol`.
+fn from_state(
+    op: &mut solver::operator::Operator,
+    sol: &solver::tangential::TangentialSolution,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = sol.qx.len();
+    let (mut ux, mut uy) = (vec![0.0; n], vec![0.0; n]);
+    op.tangential(&sol.qx, &sol.qy, &mut ux, &mut uy);
+    (
+        ux.iter().map(|v| -v).collect(),
+        uy.iter().map(|v| -v).collect(),
+    )
+}
+
+/// The displacement-controlled solve meets its KKT conditions, checked on
+/// its tractions independently of the solver (whole-grid operator, Table
+/// 1a on a contact window): every traction within its disc, stick cells
+/// without slip and slip cells' tractions opposing their slip, to the
+/// tolerance relative to |δ|; from rest in partial and gross slip, and on
+/// warm-started reversals from a partial-slip and a gross-slip state (the
+/// increment's slip measured from the previous state, as a history does).
+#[test]
+fn displacement_solve_meets_the_kkt_conditions_on_the_whole_grid() {
+    let tol = 1e-8;
+    let (mut op, p) = common::hertz_fe(128, 3.7e-6);
+    let mut windows = solver::window::WindowCache::default();
+    let (_, ds) = delta_star();
+    let problem = |shift: f64| DisplacementProblem {
+        p: &p,
+        friction: MU,
+        shift: [shift, 0.0],
+        extra: None,
+        tolerance: tol,
+        slip_floor: 0.0,
+        max_iterations: 20_000,
+        start: TangentialStart::Proportional,
+    };
+    let mut check = |op: &mut solver::operator::Operator,
+                     prob: &DisplacementProblem,
+                     what: &str| {
+        let sol =
+            solver::tangential_displacement::solve_displacement(op, &mut windows, prob).unwrap();
+        let r = kkt_on_grid(op, &p, &sol, prob.shift, prob.extra);
+        let sticks = sol.stick.iter().filter(|&&s| s).count();
+        println!(
+            "{what}: {} iterations ({} split updates), stick cells {sticks}, disc excess {:.1e}, stick slip {:.2e}, misalignment {:.2e} (reported {:.2e}, {:.2e})",
+            sol.report.iterations,
+            sol.report.split_updates,
+            r[0],
+            r[1],
+            r[2],
+            sol.report.stick_residual,
+            sol.report.slip_residual
+        );
+        assert!(sol.report.converged, "{what}");
+        assert!(r[0] <= 1e-12, "{what}: a traction over its disc");
+        assert!(r[1] <= 1.01 * tol, "{what}: stick cells slip");
+        assert!(r[2] <= 1.01 * tol, "{what}: slip against the traction");
+        assert_eq!(r[3], 0.0, "{what}: traction outside the contact");
+        sol
+    };
+    for ratio in [0.3, 0.9, 1.5] {
+        let prev = check(
+            &mut op,
+            &problem(ratio * ds),
+            &format!("{ratio} δ* from rest"),
+        );
+        // Reversal to −0.6 of the state's shift.
+        let (ex, ey) = from_state(&mut op, &prev);
+        let back = DisplacementProblem {
+            extra: Some((&ex, &ey)),
+            start: TangentialStart::Tractions(&prev.qx, &prev.qy),
+            ..problem(-1.6 * ratio * ds)
+        };
+        check(&mut op, &back, &format!("{ratio} δ* → {} δ*", -0.6 * ratio));
+    }
+}
+
+/// The force-controlled solver (projected CG, independent of the active set
+/// but for the KKT test), given the force the displacement-controlled solve
+/// returned, finds the imposed shift and the same tractions: from rest at
+/// 0.5 δ* and on the warm-started reversal to −0.3 δ* (tolerance 1e-8 for
+/// both: shifts within 1e-7, tractions within 1e-6 μ p_max).
+#[test]
+fn displacement_solve_agrees_with_the_force_solve_at_its_force() {
+    use solver::tangential::{solve_tangential, TangentialMethod, TangentialProblem};
+    let tol = 1e-8;
+    let (mut op, p) = common::hertz_fe(128, 3.7e-6);
+    let mut windows = solver::window::WindowCache::default();
+    let da = op.grid().cell_area();
+    let (_, ds) = delta_star();
+    let compare = |op: &mut solver::operator::Operator,
+                   windows: &mut solver::window::WindowCache,
+                   prob: &DisplacementProblem,
+                   what: &str| {
+        let disp = solver::tangential_displacement::solve_displacement(op, windows, prob).unwrap();
+        let force = [
+            disp.qx.iter().sum::<f64>() * da,
+            disp.qy.iter().sum::<f64>() * da,
+        ];
+        let forced = solve_tangential(
+            op,
+            windows,
+            &TangentialProblem {
+                p: &p,
+                friction: MU,
+                force,
+                extra: prob.extra,
+                tolerance: tol,
+                slip_floor: 0.0,
+                max_iterations: 20_000,
+                start: prob.start,
+                precondition: false,
+                method: TangentialMethod::ConjugateGradient,
+            },
+        )
+        .unwrap();
+        let (dq, dt, stick) = common::tangential_difference(&disp, &forced, &p);
+        println!(
+            "{what}: F = {:.6e} N; displacement {} it, force {} it; max|Δq|/μp_max {dq:.2e}, Δδt/δt {dt:.2e}, stick cells differing {stick}",
+            force[0], disp.report.iterations, forced.report.iterations
+        );
+        assert!(disp.report.converged && forced.report.converged, "{what}");
+        assert!(dt < 1e-7, "{what}: the force's shift is the imposed one");
+        assert!(dq < 1e-6, "{what}: the same tractions");
+        assert!(stick <= 4, "{what}: the same stick zone");
+        disp
+    };
+    let rest = DisplacementProblem {
+        p: &p,
+        friction: MU,
+        shift: [0.5 * ds, 0.0],
+        extra: None,
+        tolerance: tol,
+        slip_floor: 0.0,
+        max_iterations: 20_000,
+        start: TangentialStart::Proportional,
+    };
+    let prev = compare(&mut op, &mut windows, &rest, "0.5 δ* from rest");
+    let (ex, ey) = from_state(&mut op, &prev);
+    let back = DisplacementProblem {
+        shift: [-0.8 * ds, 0.0],
+        extra: Some((&ex, &ey)),
+        start: TangentialStart::Tractions(&prev.qx, &prev.qy),
+        ..rest
+    };
+    compare(&mut op, &mut windows, &back, "reversal 0.5 δ* → −0.3 δ*");
+}

@@ -41,6 +41,12 @@
 //!   change; the last run goes to the tolerance.
 //! * **Projection guess:** before the first PCG, stick cells that the force
 //!   shift put over their bounds become slip cells.
+//! * **Without the force condition** ([`Condition::Shift`], displacement
+//!   control): `δ` is imposed (the caller folds it into `e`, so the slip is
+//!   measured from it) and `Σ q` is free. The frozen system is then SPD on
+//!   the whole space, the PCG runs with `M` alone (no deflation, no `P_M`,
+//!   no force shift, no columns `M e_k`), and a split without stick cells
+//!   (gross slip) is solved like any other.
 
 use crate::base::parallel::{Chunks, Threads};
 use crate::error::SolverError;
@@ -158,7 +164,14 @@ pub(crate) struct Outcome {
 /// and Jacobi from 16 C₀₀ the linear solve on a converged split takes 8–10
 /// iterations from 64² to 1024², largest Ritz value 2.5–4.4; three nodes
 /// 3/10/30 C₀₀ keep it at 2.8 for 1.7× the transforms and the same counts on
-/// a history.)
+/// a history.) Without the force condition the node is left out, the slip
+/// cells between [`SOFT`] and [`JACOBI`] interpolated between the plain
+/// inverse and Jacobi: it saved more iterations than the second inverse of
+/// each costs nowhere (Table 1a at 128², 2 displacement-controlled cycles,
+/// operator and inverse applications with / without the node: Δ = 0.05 µm
+/// 2244 / 1844 at 10 increments per segment, 404 / 317 at 1; coupled 3789 /
+/// 3182 and 626 / 509; Δ = 0.4 µm coupled 3385 / 2890; all without the
+/// start guess of [`crate::solve::tangential_displacement`]).
 const NODE: f64 = 4.0;
 /// See [`NODE`].
 const JACOBI: f64 = 16.0;
@@ -209,6 +222,9 @@ struct Split {
 /// Per-solve constants and scratch fields.
 struct Work<'a> {
     set: &'a Feasible<'a>,
+    /// Whether `Σ q = target` binds (force control); without it the shift
+    /// is imposed (zero in the slip the caller supplies).
+    force: bool,
     extra: Option<(&'a [f64], &'a [f64])>,
     /// A whole cell's own compliance `C₀₀`, m/Pa, and the cut cells' extra
     /// own compliance (ascending cells, [`Operator::extra_diagonal`]).
@@ -336,6 +352,10 @@ impl<'a> Work<'a> {
                 (1.0, 0.0, 0.0)
             } else if k >= JACOBI {
                 (0.0, 0.0, 1.0)
+            } else if !self.force {
+                // No shifted node (see [`NODE`]): plain inverse to Jacobi.
+                let wj = (k.ln() - l_soft) / (l_jac - l_soft);
+                (1.0 - wj, 0.0, wj)
             } else if k <= NODE {
                 let w1 = (k.ln() - l_soft) / (l_node - l_soft);
                 (1.0 - w1, w1, 0.0)
@@ -352,7 +372,7 @@ impl<'a> Work<'a> {
         }
         bb[1][0] = bb[0][1];
         sp.bb = bb;
-        if !columns {
+        if !columns || !self.force {
             return;
         }
         // M e_k, e_k = R (unit vector k).
@@ -381,6 +401,9 @@ impl<'a> Work<'a> {
 
     /// `r −= B (Bᵀ B)⁻¹ Bᵀ r` (the residual update of projected CG).
     fn deflate(&self, sp: &Split, (rx, ry): (&mut [f64], &mut [f64])) {
+        if !self.force {
+            return;
+        }
         let y = solve_or_zero(sp.bb, self.sums((rx, ry)));
         for &i in self.set.cells {
             if sp.stick[i] {
@@ -397,6 +420,9 @@ impl<'a> Work<'a> {
 
     /// `z −= M B (Bᵀ M B)⁻¹ Bᵀ z`: `M r` into `P_M r`.
     fn project(&self, sp: &Split, (zx, zy): (&mut [f64], &mut [f64])) {
+        if !self.force {
+            return;
+        }
         let c = solve_or_zero(sp.gram, self.sums((zx, zy)));
         let [(m1x, m1y), (m2x, m2y)] = &sp.me;
         for &i in self.set.cells {
@@ -417,6 +443,9 @@ impl<'a> Work<'a> {
         (xx, xy): (&mut [f64], &mut [f64]),
         (dx, dy): (&mut [f64], &mut [f64]),
     ) {
+        if !self.force {
+            return;
+        }
         let s = self.sums((xx, xy));
         let target = self.set.target;
         let c = solve_or_zero(sp.gram, [target[0] - s[0], target[1] - s[1]]);
@@ -459,6 +488,9 @@ impl<'a> Work<'a> {
     /// The KKT measure with slip cells' term `slip(i, s_i − δ)`: `δ` the
     /// stick cells' mean slip, the max over stick cells of `|s − δ|` and
     /// over slip cells of their term, relative to `max(|δ|, floor)`.
+    /// Without the force condition `δ` is zero (imposed, and folded into
+    /// the slip by the caller, whose floor carries its size) and a split
+    /// without stick cells is measured like any other.
     fn measure(
         &self,
         sp: &Split,
@@ -467,18 +499,22 @@ impl<'a> Work<'a> {
         slip: impl Fn(usize, [f64; 2]) -> f64,
     ) -> Option<(f64, [f64; 2], f64)> {
         let cells = self.set.cells;
-        let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
-        for &i in cells {
-            if sp.stick[i] {
-                mx += sx[i];
-                my += sy[i];
-                ns += 1;
+        let d = if self.force {
+            let (mut mx, mut my, mut ns) = (0.0, 0.0, 0usize);
+            for &i in cells {
+                if sp.stick[i] {
+                    mx += sx[i];
+                    my += sy[i];
+                    ns += 1;
+                }
             }
-        }
-        if ns == 0 {
-            return None;
-        }
-        let d = [mx / ns as f64, my / ns as f64];
+            if ns == 0 {
+                return None;
+            }
+            [mx / ns as f64, my / ns as f64]
+        } else {
+            [0.0; 2]
+        };
         let scale = norm(d[0], d[1]).max(floor).max(f64::MIN_POSITIVE);
         let mut e = 0.0_f64;
         for &i in cells {
@@ -618,16 +654,45 @@ pub(crate) fn slip_field(
     }
 }
 
-/// Solves the partial-slip problem of `set` from the feasible tractions `q`
-/// (a start whose cells on their rims are its slip cells), leaving the
-/// solution in `q` and its slip field `C q + e` in `s`. Returns with
-/// `converged` false when the budget or [`MAX_OUTER`] outer updates run out,
-/// or no stick cell is left; the caller's projected-gradient phase then
-/// continues from `q`.
+/// What the iteration holds besides the friction discs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Condition {
+    /// `Σ q = set.target` (force control): `δ`, the stick cells' mean slip,
+    /// is its multiplier; the start's slip is computed here.
+    Force,
+    /// Nothing more (displacement control): `δ` is imposed, folded by the
+    /// caller into `e` (negated), so stick cells' slip `C q + e` must
+    /// vanish; `set.target` is not read; `ctl.floor` is the measure's scale
+    /// (the caller's `max(|δ|, floor)`); `s` holds the start's slip on entry
+    /// (the caller computed it to choose the start); the returned `shift`
+    /// is zero.
+    Shift,
+}
+
+/// Solves the force-controlled partial-slip problem of `set`:
+/// [`active_set_under`] with [`Condition::Force`].
 pub(crate) fn active_set(
     op: &mut Operator,
     extra: Option<(&[f64], &[f64])>,
     set: &Feasible,
+    ctl: Controls,
+    q: (&mut [f64], &mut [f64]),
+    s: (&mut [f64], &mut [f64]),
+) -> Result<Outcome, SolverError> {
+    active_set_under(op, extra, set, Condition::Force, ctl, q, s)
+}
+
+/// Solves the partial-slip problem of `set` under `condition` from the
+/// feasible tractions `q` (a start whose cells on their rims are its slip
+/// cells), leaving the solution in `q` and its slip field `C q + e` in `s`.
+/// Returns with `converged` false when the budget or [`MAX_OUTER`] outer
+/// updates run out, or (force control) no stick cell is left; the caller's
+/// projected-gradient phase then continues from `q`.
+pub(crate) fn active_set_under(
+    op: &mut Operator,
+    extra: Option<(&[f64], &[f64])>,
+    set: &Feasible,
+    condition: Condition,
     ctl: Controls,
     (qx, qy): (&mut [f64], &mut [f64]),
     (sx, sy): (&mut [f64], &mut [f64]),
@@ -637,8 +702,10 @@ pub(crate) fn active_set(
     let z = || vec![0.0; len];
     let mut cut = op.extra_diagonal().unwrap_or_default();
     cut.sort_unstable_by_key(|&(c, _)| c);
+    let force = condition == Condition::Force;
     let mut w = Work {
         set,
+        force,
         extra,
         c00: op.tangential_self(),
         cut,
@@ -661,8 +728,10 @@ pub(crate) fn active_set(
             sp.nx[i] = 1.0;
         }
     }
-    slip_field(op, w.extra, (qx, qy), (sx, sy));
-    w.out.applications += 1;
+    if force {
+        slip_field(op, w.extra, (qx, qy), (sx, sy));
+        w.out.applications += 1;
+    }
     let (mut dqx, mut dqy) = (z(), z());
     // κ of the start. Its force is met and its stick cells are within their
     // bounds (the caller's projection), so it is frozen only if it needs a
