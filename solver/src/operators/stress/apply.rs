@@ -145,7 +145,7 @@ impl StressPlan {
         lines: &[Line],
     ) -> Result<Vec<Vec<Vec<StressField>>>, SolverError> {
         for &z in depths_m {
-            check_depth(z)?;
+            check_depth(z, &self.grid)?;
         }
         // Per row: its near field when it is shallow.
         let near: Vec<Option<NearField>> = depths_m
@@ -380,9 +380,12 @@ impl StressPlan {
         let first_anchor = ((lo / da).floor() as i64 - 1).max(0);
         let last_anchor = ((hi / da).ceil() as i64 + 1).max(first_anchor + 3);
         let anchors = (last_anchor - first_anchor + 1) as usize;
+        // (every anchor with the lattices of the deepest: the images are
+        // then smooth in z between anchors)
+        let levels = self.image_levels(last_anchor as f64 * da);
         let anchored: Option<Vec<Arc<Vec<[C; 18]>>>> = (anchors < rows).then(|| {
             (first_anchor..=last_anchor)
-                .map(|k| self.images_at(k as f64 * da))
+                .map(|k| self.images_at(k as f64 * da, levels))
                 .collect()
         });
         for (r, &z) in depths_m.iter().enumerate() {
@@ -391,7 +394,7 @@ impl StressPlan {
                 kernel: Vec::new(),
                 images: match &anchored {
                     // (not kept: a case's rows sit at depths of its own)
-                    None => Arc::new(self.image_spectra(z)),
+                    None => Arc::new(self.image_spectra(z, self.image_levels(z))),
                     Some(spectra) => {
                         let u = z / da - first_anchor as f64;
                         let first = (u.floor() as i64 - 1).clamp(0, anchors as i64 - 4) as usize;
@@ -455,7 +458,7 @@ impl StressPlan {
 /// themselves: `σzz = −p`, `σxz = −qx`, `σyz = −qy` in each cell (z into
 /// the body; the traction on the body is `−σ·e_z`). The transform of the
 /// cell's step would converge to them only slowly.
-pub(super) fn surface_tractions_exact(field: &mut StressField, t: &TractionSpectra) {
+fn surface_tractions_exact(field: &mut StressField, t: &TractionSpectra) {
     let [qx, qy, p] = &t.fields;
     for i in 0..field.len() {
         field.components[2][i] = -p[i];
@@ -465,12 +468,7 @@ pub(super) fn surface_tractions_exact(field: &mut StressField, t: &TractionSpect
 }
 
 /// [`surface_tractions_exact`] along `line` of an `n x n` grid.
-pub(super) fn surface_tractions_on_line(
-    field: &mut StressField,
-    t: &TractionSpectra,
-    line: Line,
-    n: usize,
-) {
+fn surface_tractions_on_line(field: &mut StressField, t: &TractionSpectra, line: Line, n: usize) {
     let [qx, qy, p] = &t.fields;
     let pick = |f: &[f64], i: usize| match line {
         Line::Row(iy) => f[iy * n + i],

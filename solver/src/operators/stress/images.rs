@@ -11,11 +11,36 @@ use crate::operators::fft2::Fft2;
 
 /// Coarse points per padded period on which the periodic images of a
 /// kernel are estimated and convolved (see [`StressPlan::images`]).
-pub(super) const COARSE: usize = 32;
+const COARSE: usize = 32;
 
 /// The wider lattice's period, in padded periods (its own images weigh
-/// `WIDER⁻³` of the first).
-pub(super) const WIDER: usize = 4;
+/// `WIDER⁻³` of the first while the depth is well inside it).
+const WIDER: usize = 4;
+
+/// The widest lattice's period over the depth, from which its own images
+/// are left out (see [`StressPlan::image_levels`]): below the depth `z`
+/// the images of a lattice of period `L` leave about `F z/L³` in the
+/// stresses (`F` the load), and at `L = 128 z` the stresses of tractions
+/// confined to the domain are Boussinesq's and Cerruti's to 1.6e-5 of
+/// their scale `3F/(2πz²)` from 2a to 10⁴a
+/// (`deep_planes_carry_boussinesq_and_cerruti_fields_to_a_thousand_domain_widths`;
+/// at `L = 4T`, the only lattice before issue #59, σzz had a floor of
+/// `−F/(16T²)`).
+const IMAGE_REACH: f64 = 128.0;
+
+/// The widest lattice's period in padded periods at any depth: near the
+/// surface the in-plane stresses fall like `1/r²`, so a lattice of period
+/// `L` leaves about `F/L²` there; on a Hertz contact 4a wide (`T = 8a`),
+/// 8e-5 p0 at `L = 4T`, 1.2e-6 at `16T`, 2e-8 at `64T`.
+const IMAGE_FLOOR: f64 = 64.0;
+
+/// The decay the smoothing of the lattice sums leaves at the coarse
+/// grid's Nyquist number, with the response's own: `e^{−9}` = 1.2e-4.
+const SMOOTHING: f64 = 9.0;
+
+/// Most lattices summed, a guard: the deepest plane a plan computes
+/// (`MAX_DEPTH_PERIODS`, 10⁶ padded periods) needs 13.
+const MAX_IMAGE_LEVELS: usize = 24;
 
 /// The coarse grid over the window on which the periodic images are
 /// subtracted in real space (a DC-FFT of its own, see
@@ -26,7 +51,7 @@ pub(super) const WIDER: usize = 4;
 /// it instead of 0), and each cell's 4-point Lagrange weights on them (the
 /// same along x and y: both periods are `2n` cells).
 pub(super) struct Coarse {
-    pub(super) nc: usize,
+    nc: usize,
     pub(super) fft: Fft2,
     /// Per cell index: its first node and the four weights.
     pub(super) weights: Vec<(usize, [f64; 4])>,
@@ -116,7 +141,7 @@ pub(super) struct Images {
 
 impl Images {
     /// Component `c` at the coarse offset `(mx, my)` (within `reach`).
-    pub(super) fn at_node(&self, c: usize, mx: i64, my: i64) -> f64 {
+    fn at_node(&self, c: usize, mx: i64, my: i64) -> f64 {
         let width = 2 * self.reach as usize + 1;
         self.values[(my + self.reach) as usize * width + (mx + self.reach) as usize][c]
     }
@@ -133,11 +158,93 @@ impl StressPlan {
     /// cancels in the difference), and interpolated. Without it, the
     /// in-plane stresses at depth z carry an offset of order `F z / T³`
     /// (1 % of p0 at z = 1.5a on a domain 4a wide).
-    pub(super) fn images(&self, z: f64, coarse: usize) -> Images {
+    pub(super) fn images(&self, z: f64, coarse: usize, levels: usize) -> Images {
+        let reach = coarse as i64 / 2 + 4;
+        let mut values = self.lattice_difference(z, coarse, 1.0, reach);
+        // The wider lattice's own images, when the depth reaches them: the
+        // difference of the next two lattices, each `WIDER` times wider,
+        // on its own coarser points, interpolated at these.
+        let width = 2 * reach as usize + 1;
+        for level in 1..levels {
+            let stretch = (WIDER as f64).powi(level as i32);
+            let outer = (reach as f64 / stretch).ceil() as i64 + 2;
+            let wide = self.lattice_difference(z, coarse, stretch, outer);
+            let at = |mx: i64, my: i64| {
+                &wide[(my + outer) as usize * (2 * outer as usize + 1) + (mx + outer) as usize]
+            };
+            // The first of the 4 points of offset `m` and its weights.
+            let stencil = |m: i64| {
+                let u = m as f64 / stretch;
+                let first = u.floor();
+                (first as i64 - 1, lagrange4(u - first))
+            };
+            for my in -reach..=reach {
+                let (fy, wy) = stencil(my);
+                for mx in -reach..=reach {
+                    let (fx, wx) = stencil(mx);
+                    let v = &mut values[(my + reach) as usize * width + (mx + reach) as usize];
+                    for (a, wa) in wy.iter().enumerate() {
+                        for (b, wb) in wx.iter().enumerate() {
+                            let src = at(fx + b as i64, fy + a as i64);
+                            for (x, s) in v.iter_mut().zip(src) {
+                                *x += wa * wb * s;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Images { reach, values }
+    }
+
+    /// The lattices whose images [`StressPlan::images`] sums down to depth
+    /// `z`: the padded period's and `WIDER` times it, then as many more,
+    /// each `WIDER` times the last, as make the widest period at least
+    /// `IMAGE_REACH` times the depth, and at least `IMAGE_FLOOR` padded
+    /// periods (at most `MAX_IMAGE_LEVELS`). A plane takes its own depth's;
+    /// a slice's rows, which interpolate the images between anchor depths,
+    /// all take their deepest row's (a lattice added from one anchor to the
+    /// next would be a step there).
+    pub(super) fn image_levels(&self, z: f64) -> usize {
+        let t = 2.0 * self.grid.n as f64 * self.grid.dx.max(self.grid.dy);
+        let widest = (IMAGE_REACH * z).max(IMAGE_FLOOR * t);
+        let mut period = WIDER as f64 * t;
+        let mut levels = 1;
+        while period < widest && levels < MAX_IMAGE_LEVELS {
+            period *= WIDER as f64;
+            levels += 1;
+        }
+        levels
+    }
+
+    /// `E` of the lattice `stretch` times the padded period's (the
+    /// periodised kernel less that of the lattice `WIDER` times wider, both
+    /// smoothed over the coarse spacing, `stretch` times this grid's
+    /// `T/coarse`) at its coarse offsets `m`, `|m| ≤ reach` in both axes.
+    fn lattice_difference(
+        &self,
+        z: f64,
+        coarse: usize,
+        stretch: f64,
+        reach: i64,
+    ) -> Vec<[f64; 18]> {
         let n = self.grid.n;
-        let (tx, ty) = (2.0 * n as f64 * self.grid.dx, 2.0 * n as f64 * self.grid.dy);
+        let (tx, ty) = (
+            2.0 * n as f64 * self.grid.dx * stretch,
+            2.0 * n as f64 * self.grid.dy * stretch,
+        );
         let (cx, cy) = (tx / coarse as f64, ty / coarse as f64);
-        let rho_c = std::f64::consts::PI / (3.0 * cx.max(cy));
+        // The smoothing `e^{−(ρ/ρc)²}`, `(ρmax/ρc)² = 9 e^{−u/9}` with
+        // `u = slowest ρmax z` the response's own decay at the coarse
+        // grid's Nyquist number `ρmax`: the two leave `e^{−u − 9e^{−u/9}}
+        // ≤ e^{−9}` there, as at the surface, and the smoothing fades
+        // smoothly with the depth (the slices' rows interpolate the images
+        // between depths). The images it also blurs are at least half a
+        // period away; smoothing them as at the surface, `ρc = ρmax/3`,
+        // had left σzz 0.3 % low at depths of a period and beyond.
+        let rho_max = std::f64::consts::PI / cx.max(cy);
+        let decay = self.response.slowest * rho_max * z;
+        let squeeze = SMOOTHING * (-decay / SMOOTHING).exp() / (rho_max * rho_max);
         let (dx, dy) = (self.grid.dx, self.grid.dy);
         let tau = 2.0 * std::f64::consts::PI;
         // The kernel periodised with period `periods · T`, smoothed, at the
@@ -164,7 +271,7 @@ impl StressPlan {
                         let rho = (ex * ex + ey * ey).sqrt();
                         let b = sinc(0.5 * ex * dx)
                             * sinc(0.5 * ey * dy)
-                            * (-(rho / rho_c).powi(2)).exp();
+                            * (-rho * rho * squeeze).exp();
                         self.response.at(ex, ey, z).map(|v| v * b)
                     }
                 })
@@ -203,7 +310,6 @@ impl StressPlan {
         };
         let near = periodic(1);
         let far = periodic(WIDER);
-        let reach = coarse as i64 / 2 + 4;
         let width = 2 * reach as usize + 1;
         let wrap = |m: i64, side: usize| m.rem_euclid(side as i64) as usize;
         let mut values = vec![[0.0; 18]; width * width];
@@ -216,23 +322,25 @@ impl StressPlan {
                     std::array::from_fn(|c| a[c] - b[c]);
             }
         }
-        Images { reach, values }
+        values
     }
 
-    /// [`StressPlan::image_spectra`] at depth `z`, computed once per plan.
-    pub(super) fn images_at(&mut self, z: f64) -> Arc<Vec<[C; 18]>> {
-        if let Some(v) = self.images.get(&z.to_bits()) {
+    /// [`StressPlan::image_spectra`] at depth `z` with `levels` lattices,
+    /// computed once per plan.
+    pub(super) fn images_at(&mut self, z: f64, levels: usize) -> Arc<Vec<[C; 18]>> {
+        if let Some(v) = self.images.get(&(z.to_bits(), levels)) {
             return v.clone();
         }
-        let v = Arc::new(self.image_spectra(z));
-        self.images.insert(z.to_bits(), v.clone());
+        let v = Arc::new(self.image_spectra(z, levels));
+        self.images.insert((z.to_bits(), levels), v.clone());
         v
     }
 
-    /// The coarse spectra of the periodic images at depth `z`
-    /// ([`StressPlan::images`]) for the real-space correction.
-    pub(super) fn image_spectra(&mut self, z: f64) -> Vec<[C; 18]> {
-        let images = self.images(z, COARSE);
+    /// The coarse spectra of the periodic images at depth `z` summed over
+    /// `levels` lattices ([`StressPlan::images`]) for the real-space
+    /// correction.
+    pub(super) fn image_spectra(&mut self, z: f64, levels: usize) -> Vec<[C; 18]> {
+        let images = self.images(z, COARSE, levels);
         // E at the coarse offsets m in [−nc, nc), periodic on the coarse
         // padded grid, and its 18 spectra.
         let nc = self.coarse.nc;

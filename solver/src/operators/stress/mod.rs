@@ -36,6 +36,7 @@
 use nalgebra::{Matrix3, SMatrix};
 use num_complex::Complex64;
 
+use crate::base::grid::Grid;
 use crate::error::SolverError;
 
 mod apply;
@@ -100,14 +101,34 @@ pub enum Line {
     Column(usize),
 }
 
-fn check_depth(depth_m: f64) -> Result<(), SolverError> {
+/// The deepest plane or row computed, in padded periods `2 n Δ` of the
+/// grid (the larger side): far below any part a contact stresses (10⁶
+/// domains of a millimetre are a kilometre), and within the lattices
+/// whose images are subtracted (`images`).
+pub const MAX_DEPTH_PERIODS: f64 = 1e6;
+
+/// A depth below the surface of a plan on `grid`: finite, ≥ 0 and within
+/// [`MAX_DEPTH_PERIODS`].
+fn check_depth(depth_m: f64, grid: &Grid) -> Result<(), SolverError> {
     if !depth_m.is_finite() || depth_m < 0.0 {
         return Err(SolverError::invalid(
             "depth",
             format!("a depth below the surface must be finite and ≥ 0, got {depth_m} m"),
         ));
     }
+    let deepest = max_depth_m(grid);
+    if depth_m > deepest {
+        return Err(SolverError::invalid(
+            "depth",
+            format!("a depth below the surface must be at most {deepest} m ({MAX_DEPTH_PERIODS} padded periods of the grid), got {depth_m} m"),
+        ));
+    }
     Ok(())
+}
+
+/// The deepest plane or row computed on `grid`, m ([`MAX_DEPTH_PERIODS`]).
+pub fn max_depth_m(grid: &Grid) -> f64 {
+    MAX_DEPTH_PERIODS * 2.0 * grid.n as f64 * grid.dx.max(grid.dy)
 }
 
 /// `sin(u)/u`.

@@ -11,7 +11,7 @@ pub(super) const ALIAS_FREE_DEPTH_CELLS: f64 = 5.0;
 
 /// At depth `z` the alias orders beyond `NEAR_DECAY_CELLS Δ / z` weigh
 /// below `e^{−2π NEAR_DECAY_CELLS}` = 6.5e-9 and are left out.
-pub(super) const NEAR_DECAY_CELLS: f64 = 3.0;
+const NEAR_DECAY_CELLS: f64 = 3.0;
 
 /// Most aliases summed per axis and side in a shallow plane's near field
 /// (at the surface itself the series is truncated here).
@@ -19,17 +19,17 @@ pub(super) const NEAR_ALIASES: i64 = 16;
 
 /// The split's radius in units of the grid's Nyquist wave numbers (see
 /// [`StressPlan::split`]).
-pub(super) const SPLIT_RADIUS: f64 = 0.5;
+const SPLIT_RADIUS: f64 = 0.5;
 
 /// The split's order: `w = exp(−(|u|/SPLIT_RADIUS)^(2 SPLIT_POWER))`.
-pub(super) const SPLIT_POWER: i32 = 3;
+const SPLIT_POWER: i32 = 3;
 
 /// Below this weight a frequency's smooth part is left out (0 to round-off).
 pub(super) const SPLIT_FLOOR: f64 = 1e-20;
 
 /// Frequencies per axis of the coarse grid a near field is summed on (its
 /// period in cells).
-pub(super) const NEAR_PERIOD: usize = 41;
+const NEAR_PERIOD: usize = 41;
 
 /// Cells either side of the source a near field reaches.
 pub(super) const NEAR_REACH: usize = 16;
@@ -77,7 +77,7 @@ impl StressPlan {
 
     /// `(|u|/SPLIT_RADIUS)^(2 SPLIT_POWER)`: `w = e^{−x}` and, without
     /// cancellation near `η = 0`, `1 − w = −expm1(−x)`.
-    pub(super) fn split_exponent(&self, ex: f64, ey: f64) -> f64 {
+    fn split_exponent(&self, ex: f64, ey: f64) -> f64 {
         let ux = ex * self.grid.dx / std::f64::consts::PI;
         let uy = ey * self.grid.dy / std::f64::consts::PI;
         ((ux * ux + uy * uy) / (SPLIT_RADIUS * SPLIT_RADIUS)).powi(SPLIT_POWER)
@@ -85,7 +85,7 @@ impl StressPlan {
 
     /// `(1 − w)F` at depth `z` summed over `aliases` orders (the last
     /// counted half) on the near field's coarse frequencies, `[ky][kx]`.
-    pub(super) fn near_spectrum(&self, z: f64, aliases: i64) -> Vec<[C; 18]> {
+    fn near_spectrum(&self, z: f64, aliases: i64) -> Vec<[C; 18]> {
         use rayon::prelude::*;
         let mc = NEAR_PERIOD;
         let (dx, dy) = (self.grid.dx, self.grid.dy);

@@ -23,10 +23,11 @@ pub struct StressPlan {
     pub(super) dc: [C; 18],
     pub(super) fft: Fft2,
     pub(super) coarse: Coarse,
-    /// The image spectra computed so far, by depth (bits): they depend on
+    /// The image spectra computed so far, by depth (bits) and lattices
+    /// summed (`StressPlan::image_levels`): they depend on
     /// the material, the grid and the depth only, so the cases of a sweep
     /// share them through the plan a worker keeps.
-    pub(super) images: HashMap<u64, Arc<Vec<[C; 18]>>>,
+    pub(super) images: HashMap<(u64, usize), Arc<Vec<[C; 18]>>>,
 }
 
 /// The spectra of a state's tractions on the padded grid (three forward
@@ -100,7 +101,7 @@ impl StressPlan {
     /// `(kx, ky)`: the response times the cell's transform, times the
     /// split's weight when `split` (a shallow plane: its aliases and the
     /// rest are in its near field).
-    pub(super) fn kernel_at(&self, kx: usize, ky: usize, z: f64, split: bool) -> [C; 18] {
+    fn kernel_at(&self, kx: usize, ky: usize, z: f64, split: bool) -> [C; 18] {
         let m = 2 * self.grid.n;
         if kx == 0 && ky == 0 {
             return self.dc;
@@ -142,7 +143,7 @@ impl StressPlan {
         depth_m: f64,
         cap: i64,
     ) -> Result<StressPlane, SolverError> {
-        check_depth(depth_m)?;
+        check_depth(depth_m, &self.grid)?;
         let n = self.grid.n;
         let m = 2 * n;
         let h = m / 2 + 1;
@@ -162,7 +163,7 @@ impl StressPlan {
             let near = self.near_field(depth_m, aliases);
             self.add_near(&near, &mut kernel);
         }
-        let image_spectra = self.images_at(depth_m);
+        let image_spectra = self.images_at(depth_m, self.image_levels(depth_m));
         Ok(StressPlane {
             depth_m,
             kernel,

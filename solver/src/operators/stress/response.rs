@@ -25,7 +25,7 @@ pub(super) const DECAY_LIMIT: f64 = 36.0;
 
 /// `P`, `W`, `H` of one in-plane direction θ: `σ̂ = P exp(−isW) H t̂`.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Direction {
+struct Direction {
     pub(super) p: M63,
     pub(super) w: M3,
     pub(super) h: M3,
@@ -90,16 +90,16 @@ pub(super) struct Response {
     /// (interpolate them, then `exp(−isW)` per frequency), kept as the
     /// tests' oracle.
     #[cfg(test)]
-    pub(super) table: Vec<Direction>,
+    table: Vec<Direction>,
 }
 
 /// Series of [`phi1`] and [`divided`] below this `|x|·spread`: 16 terms
 /// leave below `0.5¹⁶/17!`, and the difference quotients above it lose at
 /// most a factor `1/0.5` to cancellation.
-pub(super) const CLUSTER: f64 = 0.5;
+const CLUSTER: f64 = 0.5;
 
 /// `φ₁(u) = (eᵘ − 1)/u` for `|u| < CLUSTER` (series).
-pub(super) fn phi1(u: C) -> C {
+fn phi1(u: C) -> C {
     let (mut sum, mut term) = (C::new(0.0, 0.0), C::new(1.0, 0.0));
     for k in 1..=16 {
         term /= k as f64;
@@ -125,18 +125,18 @@ pub(super) struct Node {
     pub(super) spread: f64,
     /// The pairs `(0, 1), (0, 2), (1, 2)`: `|λⱼ − λᵢ|` and `1/(λⱼ − λᵢ)`
     /// (0 for equal roots, never used then).
-    pub(super) gap: [f64; 3],
-    pub(super) inv: [C; 3],
+    gap: [f64; 3],
+    inv: [C; 3],
     /// The pair `(p, q)` farthest apart (an index into [`PAIRS`]) and the
     /// pairs `(r, q)`, `(r, p)` of the third root `r` with it.
     pub(super) far: usize,
-    pub(super) ends: [usize; 2],
+    ends: [usize; 2],
     /// `Q₀, Q₁, Q₂`, each 6x3 row major (`[3·row + column]`).
     pub(super) q: [[C; 18]; 3],
 }
 
 /// The root pairs of [`Node::gap`] and the root outside each.
-pub(super) const PAIRS: [(usize, usize, usize); 3] = [(0, 1, 2), (0, 2, 1), (1, 2, 0)];
+const PAIRS: [(usize, usize, usize); 3] = [(0, 1, 2), (0, 2, 1), (1, 2, 0)];
 
 pub(super) fn flat(m: &M63) -> [C; 18] {
     std::array::from_fn(|c| m[(c / 3, c % 3)])
@@ -145,11 +145,7 @@ pub(super) fn flat(m: &M63) -> [C; 18] {
 impl Node {
     /// The node of direction `d`, its roots in the order nearest `prev`'s
     /// (the previous node's) when given.
-    pub(super) fn new(
-        d: &Direction,
-        isotropic: bool,
-        prev: Option<&[C; 3]>,
-    ) -> Result<Self, SolverError> {
+    fn new(d: &Direction, isotropic: bool, prev: Option<&[C; 3]>) -> Result<Self, SolverError> {
         let i = M3::identity();
         let (lam, q) = if isotropic {
             let nil = d.w + i * C::new(0.0, 1.0);
@@ -268,7 +264,7 @@ pub(super) fn divided_with(s: f64, node: &Node, e: &[C; 3]) -> [C; 3] {
 }
 
 /// The isotropic surface compliance of PHYSICS.md §3.
-pub(super) fn isotropic_h(g: f64, nu: f64, theta: f64) -> M3 {
+fn isotropic_h(g: f64, nu: f64, theta: f64) -> M3 {
     let (s, c) = theta.sin_cos();
     let r = |v: f64| C::new(v / g, 0.0);
     let i = |v: f64| C::new(0.0, v / g);
@@ -291,7 +287,7 @@ pub(super) fn isotropic_h(g: f64, nu: f64, theta: f64) -> M3 {
 /// below 3e-17). Exact for defective matrices, which an eigenvector route is not.
 /// The tests' oracle for [`Node`]'s exponential.
 #[cfg(test)]
-pub(super) fn expm3(x: &M3) -> M3 {
+fn expm3(x: &M3) -> M3 {
     let norm = (0..3)
         .map(|j| (0..3).map(|i| x[(i, j)].norm()).sum::<f64>())
         .fold(0.0, f64::max);
@@ -320,12 +316,12 @@ pub(super) fn expm3(x: &M3) -> M3 {
 /// only 65 % of Fe(111)'s stencils qualified: a harmonic of order 6 in θ
 /// alone has a fourth difference of 1e-7 at 2048 nodes; a crossing of
 /// roots or their order wrapping at 2π gives one of order 1).
-pub(super) const SMOOTH_DIFFERENCE: f64 = 1e-6;
+const SMOOTH_DIFFERENCE: f64 = 1e-6;
 
 /// [`Response::smooth`] of a crystal's nodes: every value of each of the
 /// four nodes of a stencil (with two more either side) has a small fourth
 /// difference.
-pub(super) fn smooth_stencils(nodes: &[Node]) -> Vec<bool> {
+fn smooth_stencils(nodes: &[Node]) -> Vec<bool> {
     let k = nodes.len() as i64;
     let at = |i: i64| &nodes[i.rem_euclid(k) as usize];
     // Fourth difference centred on node i, relative.
@@ -554,7 +550,7 @@ impl Response {
 #[cfg(test)]
 impl Response {
     /// `P`, `W`, `H` along θ.
-    pub(super) fn direction(&self, theta: f64) -> Direction {
+    fn direction(&self, theta: f64) -> Direction {
         let mut d = Direction {
             p: M63::zeros(),
             w: M3::zeros(),
@@ -573,7 +569,7 @@ impl Response {
     }
 
     /// `exp(−isW)`.
-    pub(super) fn propagator(&self, d: &Direction, s: f64) -> M3 {
+    fn propagator(&self, d: &Direction, s: f64) -> M3 {
         if s == 0.0 {
             return M3::identity();
         }

@@ -57,7 +57,7 @@ impl StressPlan {
             }
         }
         const OLD_COARSE: usize = 64;
-        let images = self.images(depth_m, OLD_COARSE);
+        let images = self.images(depth_m, OLD_COARSE, self.image_levels(depth_m));
         let (cx, cy) = (
             m as f64 * dx / OLD_COARSE as f64,
             m as f64 * dy / OLD_COARSE as f64,
