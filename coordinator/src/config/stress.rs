@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
-use solver::stress_summary::StressRequest;
+use solver::stress_summary::{StressRequest, StressStates};
 
 /// Most depth planes (each costs a kernel of 18 padded spectra).
 pub const MAX_DEPTHS: usize = 64;
@@ -29,9 +29,10 @@ pub struct StressCfg {
     /// Depth rows of a slice, the surface included.
     #[serde(default = "default_rows")]
     pub slice_rows: usize,
-    /// Which states of a load history: `turning` (its turning points) or
-    /// `final` (the last increment). A case without a history has one state.
-    #[serde(default = "turning")]
+    /// Which states of a load history: `last_cycle` (the turning points of
+    /// its last cycle), `turning` (every turning point) or `final` (the
+    /// last increment). A case without a history has one state.
+    #[serde(default = "last_cycle")]
     pub states: String,
     /// Crossland's coefficient α of the largest hydrostatic stress
     /// (`√J2,a + α σH,max`), for the fretting-fatigue parameter.
@@ -52,8 +53,8 @@ fn yes() -> bool {
 fn default_rows() -> usize {
     41
 }
-fn turning() -> String {
-    "turning".into()
+fn last_cycle() -> String {
+    "last_cycle".into()
 }
 fn default_alpha() -> f64 {
     0.3
@@ -68,8 +69,17 @@ impl StressCfg {
             slices: self.slices,
             slice_depth_m: self.slice_depth_um.map(|d| d * 1e-6),
             slice_rows: self.slice_rows,
-            turning_states: self.states == "turning",
+            states: self.chosen_states(),
             crossland_alpha: self.crossland_alpha,
+        }
+    }
+
+    /// `states` as the solver's choice (checked by [`StressCfg::check`]).
+    pub fn chosen_states(&self) -> StressStates {
+        match self.states.as_str() {
+            "turning" => StressStates::Turning,
+            "final" => StressStates::Final,
+            _ => StressStates::LastCycle,
         }
     }
 
@@ -121,9 +131,9 @@ impl StressCfg {
                 self.slice_rows
             );
         }
-        if self.states != "turning" && self.states != "final" {
+        if !["last_cycle", "turning", "final"].contains(&self.states.as_str()) {
             bail!(
-                "stress.states = \"{}\": must be \"turning\" (the load history's turning points) or \"final\"",
+                "stress.states = \"{}\": must be \"last_cycle\" (the turning points of the load history's last cycle), \"turning\" (all its turning points) or \"final\"",
                 self.states
             );
         }
@@ -172,7 +182,7 @@ mod tests {
         let e = err("depths_um = [25.0, 10.0, 25.0]");
         assert!(e.contains("stress.depths_um: 25 is listed twice"), "{e}");
         let e = err("depths_um = [0.0, -0.0]");
-        assert!(e.contains("stress.depths_um: -0 is listed twice"), "{e}");
+        assert!(e.contains("stress.depths_um: 0 is listed twice"), "{e}");
         let c = Config::parse(&format!("{BASE}[stress]\ndepths_um = [-0.0, 5.0]\n"), &[]).unwrap();
         let d = &c.stress.unwrap().depths_um;
         assert_eq!(d[0].to_bits(), 0.0f64.to_bits());
@@ -206,6 +216,6 @@ mod tests {
         assert!(c.stress.is_none());
         let c = Config::parse(&format!("{BASE}[stress]\ndepths_um = [5.0]\n"), &[]).unwrap();
         let s = c.stress.unwrap();
-        assert!(s.slices && s.slice_rows == 41 && s.states == "turning");
+        assert!(s.slices && s.slice_rows == 41 && s.states == "last_cycle");
     }
 }

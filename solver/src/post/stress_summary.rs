@@ -36,11 +36,51 @@ pub struct StressRequest {
     pub slice_depth_m: Option<f64>,
     /// Rows of a slice (≥ 2), the surface included.
     pub slice_rows: usize,
-    /// With a load history: every turning point (`true`) or the final
-    /// increment only.
-    pub turning_states: bool,
+    /// With a load history, the states computed.
+    pub states: StressStates,
     /// Crossland's coefficient α.
     pub crossland_alpha: f64,
+}
+
+/// The states of a load history whose stresses are computed (a case
+/// without a history has one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StressStates {
+    /// Every turning point of the path, the start included: one state per
+    /// segment, 2002 for 1000 fretting cycles (issue #59: 8.7 GB at 32²).
+    Turning,
+    /// The turning points of the last cycle, the last
+    /// [`LAST_CYCLE_TURNING`] (+A → −A → +A of a fretting path): the
+    /// states of the cycle Crossland's and SWT's parameters are read over.
+    LastCycle,
+    /// The final increment only.
+    Final,
+}
+
+/// Turning points of one cycle: out, back and out again.
+pub const LAST_CYCLE_TURNING: usize = 3;
+
+impl StressStates {
+    /// The turning points of a path's `turning` whose stresses are
+    /// computed (none: the final increment is the one state).
+    pub fn chosen<T>(self, turning: &[T]) -> &[T] {
+        match self {
+            StressStates::Turning => turning,
+            StressStates::LastCycle => &turning[turning.len().saturating_sub(LAST_CYCLE_TURNING)..],
+            StressStates::Final => &[],
+        }
+    }
+
+    /// The states computed of a path of `turning` turning points (at
+    /// least the one final state).
+    pub fn count(self, turning: usize) -> usize {
+        match self {
+            StressStates::Turning => turning,
+            StressStates::LastCycle => turning.min(LAST_CYCLE_TURNING),
+            StressStates::Final => 1,
+        }
+        .max(1)
+    }
 }
 
 /// A value and its place (m; z into the body).
@@ -304,8 +344,8 @@ fn resolve<'a>(r: &'a PlaneRef, kept: &'a [StressPlane]) -> &'a StressPlane {
 }
 
 /// Computes the stresses `req` asks for on the states of a solved case:
-/// the turning points of its load history (or its final state), else the
-/// case's one state; and the scalars.
+/// the turning points of its load history `req.states` chooses (or its
+/// final state), else the case's one state; and the scalars.
 pub fn compute(
     req: &StressRequest,
     spec: &CaseSpec,
@@ -328,8 +368,9 @@ pub fn compute_with(
 ) -> Result<CaseStress, SolverError> {
     let grid = spec.grid;
     let n = grid.n;
-    let states: Vec<StateTractions> = if req.turning_states && !turning.is_empty() {
-        turning
+    let chosen = req.states.chosen(turning);
+    let states: Vec<StateTractions> = if !chosen.is_empty() {
+        chosen
             .iter()
             .map(|t| (Some(t.step), &t.p[..], &t.qx[..], &t.qy[..]))
             .collect()

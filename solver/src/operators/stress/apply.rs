@@ -13,6 +13,28 @@ use super::{
 };
 use crate::error::SolverError;
 
+/// Chunks of frequencies [`StressPlan::slice`] sums its partial transforms
+/// in, each holding its own (a fixed number: the sums do not depend on the
+/// threads).
+const SLICE_CHUNKS: usize = 8;
+
+/// Bytes of [`StressPlan::slice`]'s partial transforms for each state, on
+/// an `n x n` grid with `rows` depths along `lines` lines: every chunk's
+/// six components per row, line and frequency along it (2n). 3.9 MB a state
+/// at 32² with 40 rows and two lines, 31 MB at 256² (a fretting history's
+/// 2002 turning states at 32² took 8.7 GB in one call, issue #59), so
+/// [`StressPlan::slice`] takes the states in batches of
+/// [`SLICE_BATCH_BYTES`].
+pub fn slice_state_bytes(n: usize, rows: usize, lines: usize) -> usize {
+    SLICE_CHUNKS * lines * rows * 2 * n * std::mem::size_of::<[C; 6]>()
+}
+
+/// Most bytes of a slice's partial transforms held at once: 16 states a
+/// batch at 32² (40 rows), 2 at 256², one at 512² and beyond. (Batches
+/// of states computed apart cost the rows' frequency sweep each; the near
+/// fields and images are made once a slice.)
+pub const SLICE_BATCH_BYTES: usize = 64 << 20;
+
 impl StressPlan {
     /// The stress on `plane` under `t` (18 spectral products, 6 inverse transforms).
     pub fn apply(&mut self, plane: &StressPlane, t: &TractionSpectra) -> StressField {
@@ -147,7 +169,7 @@ impl StressPlan {
         for &z in depths_m {
             check_depth(z, &self.grid)?;
         }
-        // Per row: its near field when it is shallow.
+        // Per row: its near field when it is shallow, and its images.
         let near: Vec<Option<NearField>> = depths_m
             .iter()
             .map(|&z| {
@@ -155,6 +177,28 @@ impl StressPlan {
                 (aliases > 0).then(|| self.near_field(z, aliases))
             })
             .collect();
+        let images = self.row_images(depths_m);
+        // The states in batches: the partial transforms of a batch are
+        // held at once, and each state's rows are the same bits in any.
+        let each = slice_state_bytes(self.grid.n, depths_m.len(), lines.len());
+        let batch = (SLICE_BATCH_BYTES / each.max(1)).max(1);
+        let mut out = Vec::with_capacity(states.len());
+        for chunk in states.chunks(batch) {
+            out.extend(self.slice_batch(depths_m, chunk, lines, &near, &images));
+        }
+        Ok(out)
+    }
+
+    /// [`StressPlan::slice`] of one batch of `states`, with each row's
+    /// near field and image spectra.
+    fn slice_batch(
+        &mut self,
+        depths_m: &[f64],
+        states: &[TractionSpectra],
+        lines: &[Line],
+        near: &[Option<NearField>],
+        row_images: &[Arc<Vec<[C; 18]>>],
+    ) -> Vec<Vec<Vec<StressField>>> {
         let any_split = near.iter().any(Option::is_some);
         let n = self.grid.n;
         let m = 2 * n;
@@ -180,8 +224,7 @@ impl StressPlan {
         // Partial transforms `[state][line][row][k][component]`, k the
         // frequency along the line; chunks of kx in a fixed number (the
         // sums do not depend on the threads) summed in order.
-        const CHUNKS: usize = 8;
-        let size = h.div_ceil(CHUNKS);
+        let size = h.div_ceil(SLICE_CHUNKS);
         let at = |s: usize, l: usize, r: usize, k: usize| ((s * nl + l) * rows + r) * m + k;
         let this = &*self;
         let iso = self.response.isotropic;
@@ -351,7 +394,7 @@ impl StressPlan {
         };
         let parts: Vec<Vec<[C; 6]>> = {
             use rayon::prelude::*;
-            (0..CHUNKS).into_par_iter().map(partial).collect()
+            (0..SLICE_CHUNKS).into_par_iter().map(partial).collect()
         };
         let mut sums = vec![[C::default(); 6]; ns * nl * rows * m];
         for part in &parts {
@@ -366,56 +409,11 @@ impl StressPlan {
         let mut out: Vec<Vec<Vec<StressField>>> = (0..ns)
             .map(|_| (0..nl).map(|_| Vec::with_capacity(rows)).collect())
             .collect();
-        // The images vary slowly in z too (the nearest is T/2 away, T the
-        // padded period): for many rows they are interpolated between
-        // anchor depths on the lattice k T/32 (4-point Lagrange in z; T/16
-        // apart left 2.1e-6 p0 on a Hertz slice, 64², against each row's
-        // own), which the plan keeps for the next case's rows; their own
-        // lattice sums cost more than a row's products otherwise.
-        let (lo, hi) = depths_m
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &z| (a.min(z), b.max(z)));
-        let period = (m as f64 * dx).max(m as f64 * dy);
-        let da = period / 32.0;
-        let first_anchor = ((lo / da).floor() as i64 - 1).max(0);
-        let last_anchor = ((hi / da).ceil() as i64 + 1).max(first_anchor + 3);
-        let anchors = (last_anchor - first_anchor + 1) as usize;
-        // (every anchor with the lattices of the deepest: the images are
-        // then smooth in z between anchors)
-        let levels = self.image_levels(last_anchor as f64 * da);
-        let anchored: Option<Vec<Arc<Vec<[C; 18]>>>> = (anchors < rows).then(|| {
-            (first_anchor..=last_anchor)
-                .map(|k| self.images_at(k as f64 * da, levels))
-                .collect()
-        });
         for (r, &z) in depths_m.iter().enumerate() {
             let images = StressPlane {
                 depth_m: z,
                 kernel: Vec::new(),
-                images: match &anchored {
-                    // (not kept: a case's rows sit at depths of its own)
-                    None => Arc::new(self.image_spectra(z, self.image_levels(z))),
-                    Some(spectra) => {
-                        let u = z / da - first_anchor as f64;
-                        let first = (u.floor() as i64 - 1).clamp(0, anchors as i64 - 4) as usize;
-                        // Lagrange weights on anchors first..first + 4.
-                        let w: [f64; 4] = std::array::from_fn(|j| {
-                            (0..4)
-                                .filter(|&k| k != j)
-                                .map(|k| (u - (first + k) as f64) / (j as f64 - k as f64))
-                                .product()
-                        });
-                        let mut out = vec![[C::default(); 18]; spectra[0].len()];
-                        for (j, wj) in w.iter().enumerate() {
-                            for (o, v) in out.iter_mut().zip(spectra[first + j].iter()) {
-                                for (a, b) in o.iter_mut().zip(v) {
-                                    *a += b * wj;
-                                }
-                            }
-                        }
-                        Arc::new(out)
-                    }
-                },
+                images: row_images[r].clone(),
             };
             for (s, t) in states.iter().enumerate() {
                 let e = self.image_stresses(&images, t);
@@ -450,7 +448,63 @@ impl StressPlan {
                 }
             }
         }
-        Ok(out)
+        out
+    }
+
+    /// The image spectra of each row of a slice at `depths_m`.
+    fn row_images(&mut self, depths_m: &[f64]) -> Vec<Arc<Vec<[C; 18]>>> {
+        let rows = depths_m.len();
+        let m = 2 * self.grid.n;
+        let (dx, dy) = (self.grid.dx, self.grid.dy);
+        // The images vary slowly in z too (the nearest is T/2 away, T the
+        // padded period): for many rows they are interpolated between
+        // anchor depths on the lattice k T/32 (4-point Lagrange in z; T/16
+        // apart left 2.1e-6 p0 on a Hertz slice, 64², against each row's
+        // own), which the plan keeps for the next case's rows; their own
+        // lattice sums cost more than a row's products otherwise.
+        let (lo, hi) = depths_m
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &z| (a.min(z), b.max(z)));
+        let period = (m as f64 * dx).max(m as f64 * dy);
+        let da = period / 32.0;
+        let first_anchor = ((lo / da).floor() as i64 - 1).max(0);
+        let last_anchor = ((hi / da).ceil() as i64 + 1).max(first_anchor + 3);
+        let anchors = (last_anchor - first_anchor + 1) as usize;
+        // (every anchor with the lattices of the deepest: the images are
+        // then smooth in z between anchors)
+        let levels = self.image_levels(last_anchor as f64 * da);
+        let anchored: Option<Vec<Arc<Vec<[C; 18]>>>> = (anchors < rows).then(|| {
+            (first_anchor..=last_anchor)
+                .map(|k| self.images_at(k as f64 * da, levels))
+                .collect()
+        });
+        depths_m
+            .iter()
+            .map(|&z| match &anchored {
+                // (not kept: a case's rows sit at depths of its own)
+                None => Arc::new(self.image_spectra(z, self.image_levels(z))),
+                Some(spectra) => {
+                    let u = z / da - first_anchor as f64;
+                    let first = (u.floor() as i64 - 1).clamp(0, anchors as i64 - 4) as usize;
+                    // Lagrange weights on anchors first..first + 4.
+                    let w: [f64; 4] = std::array::from_fn(|j| {
+                        (0..4)
+                            .filter(|&k| k != j)
+                            .map(|k| (u - (first + k) as f64) / (j as f64 - k as f64))
+                            .product()
+                    });
+                    let mut out = vec![[C::default(); 18]; spectra[0].len()];
+                    for (j, wj) in w.iter().enumerate() {
+                        for (o, v) in out.iter_mut().zip(spectra[first + j].iter()) {
+                            for (a, b) in o.iter_mut().zip(v) {
+                                *a += b * wj;
+                            }
+                        }
+                    }
+                    Arc::new(out)
+                }
+            })
+            .collect()
     }
 }
 

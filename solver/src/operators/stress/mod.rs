@@ -49,6 +49,7 @@ mod tensor;
 #[cfg(test)]
 mod tests;
 
+pub use apply::{slice_state_bytes, SLICE_BATCH_BYTES};
 pub use fatigue::{crossland_at, swt_point, SwtPoint, SWT_DIRECTIONS};
 pub use plan::{StressPlan, StressPlane, TractionSpectra};
 pub use response::STROH_DIRECTIONS;
