@@ -80,17 +80,26 @@ const STRESS_CRYSTAL: f64 = 1.2;
 /// material), scaled as N² (the padded grid's spectra): each plane applied
 /// (the surface's for SWT included) 0.025 s with its summaries, each slice
 /// row 0.0025 s (`cargo run --release -p mpcontact-solver --example
-/// stress_cost`, one thread, issue #51).
+/// stress_cost`, one thread, issue #51), and 4.5 ms a state whatever the
+/// grid, for each state computed (`memory::stress_states`: a load
+/// history's turning points). A fretting sweep of 100 cycles with
+/// `stress.states = "turning"` (202 states, one plane, 41 slice rows) took
+/// 7 ms a state more than with `final` at 32² and 14 ms at 64² (issue #59;
+/// the N² part alone 2.4 and 9.5 ms).
 pub fn stress_seconds(spec: &CaseSpec, cfg: &crate::config::StressCfg) -> f64 {
     const APPLY_S: f64 = 0.025;
     const ROW_S: f64 = 0.0025;
+    const STATE_S: f64 = 0.0045;
     let rows = if cfg.slices {
         cfg.slice_rows as f64
     } else {
         0.0
     };
-    let per = (APPLY_S * stress_kernels(cfg) as f64 + ROW_S * rows)
-        * (spec.grid.n as f64 / 256.0).powi(2);
+    let states = crate::memory::stress_states(cfg, spec) as f64;
+    let per = states
+        * ((APPLY_S * stress_kernels(cfg) as f64 + ROW_S * rows)
+            * (spec.grid.n as f64 / 256.0).powi(2)
+            + STATE_S);
     if spec.material.is_isotropic() {
         per
     } else {

@@ -60,7 +60,11 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     });
     let per_worker = crate::memory::worker_bytes(n, kernels.len()) + stress_bytes;
     crate::memory::check_fits(
-        &format!("the sweep (finest grid {0} x {0} cells)", n),
+        &format!(
+            "the sweep (finest grid {0} x {0} cells{1})",
+            n,
+            crate::memory::stress_states_note(config.stress.as_ref(), cases.iter().map(|(_, s)| s))
+        ),
         per_worker,
         workers,
         crate::memory::available_bytes(),
@@ -200,11 +204,17 @@ pub fn report(config: &Config, workers: usize) -> Result<String> {
     let stress: f64 = match &config.stress {
         Some(cfg) => {
             let t = stress_sweep_seconds(cases.iter().map(|(_, spec)| spec), cfg, workers_used);
+            let states = cases
+                .iter()
+                .map(|(_, spec)| crate::memory::stress_states(cfg, spec))
+                .max()
+                .unwrap_or(1);
             let _ = writeln!(
                 s,
-                "stress:    {} depth kernels per material (planes and the surface for SWT; slice rows need none), built once by each worker and kept; about {:.1} s a case more on average (measured at 256², scaled as N²)",
+                "stress:    {} depth kernels per material (planes and the surface for SWT; slice rows need none), built once by each worker and kept; about {:.1} s a case more on average (measured at 256², scaled as N², for each state computed: {states} a case at most, stress.states = \"{}\")",
                 stress_kernels(cfg),
-                t / cases.len() as f64
+                t / cases.len() as f64,
+                cfg.states
             );
             t
         }

@@ -33,20 +33,28 @@ pub fn worker_bytes(n: usize, kernels: usize) -> f64 {
 /// `KEPT_PLANE_BYTES`, the current material's surface beyond it) and one
 /// more in flight when they do not all fit, the transforms' scratch (256),
 /// per state the traction spectra (96) and its planes (48 each, the
-/// surface's for SWT included), and the Crossland and SWT maps (8 each).
+/// surface's for SWT included) and its slices' rows (48 B a point, two
+/// lines of `n`), the slices' partial transforms of a batch of states,
+/// the Crossland and SWT maps (8 each), and a history's turning points'
+/// tractions (24 each).
 /// 256², Fe and Fe(111), one state, two planes and 41 slice rows (Table
 /// 1(a) with `[stress]`): 307 MB with the solve's kernels, 355 MB peak RSS
 /// measured of a worker of `mpcontact run --workers 2` (issue #51,
 /// docs/performance.md; the allocator's slack is not counted). The states
 /// and materials are those of the cases `specs` (`stress_states`,
-/// `sweep_materials`).
+/// `sweep_materials`); every state is held until the case's fields are
+/// written (Crossland's parameter reads them all at each point).
 pub fn stress_bytes<'a>(
     n: usize,
     cfg: &crate::config::StressCfg,
     specs: impl Iterator<Item = &'a solver::CaseSpec> + Clone,
 ) -> f64 {
-    let states = stress_states(cfg, specs.clone());
-    let materials = sweep_materials(specs).len();
+    let states = specs
+        .clone()
+        .map(|s| stress_states(cfg, s))
+        .max()
+        .unwrap_or(1);
+    let materials = sweep_materials(specs.clone()).len();
     let cells = (n * n) as f64;
     let planes = (cfg.depths_um.len() + 1) as f64;
     let kernel = 576.0 * cells;
@@ -57,8 +65,31 @@ pub fn stress_bytes<'a>(
     } else {
         budget + kernel
     };
-    let states = states.max(1) as f64;
-    kernels + cells * (256.0 + states * (96.0 + 48.0 * planes) + 8.0 * (planes + 1.0))
+    let rows = if cfg.slices { cfg.slice_rows } else { 0 };
+    let state = cells * (96.0 + 48.0 * planes) + 2.0 * (rows * n) as f64 * 48.0;
+    // The slices' partial transforms of a batch of states (the rows below
+    // the surface; `solver::stress::SLICE_BATCH_BYTES`).
+    let sliced = match rows.saturating_sub(1) {
+        0 => 0.0,
+        below => {
+            let each = solver::stress::slice_state_bytes(n, below, 2);
+            let batch = (solver::stress::SLICE_BATCH_BYTES / each).max(1);
+            (each * batch.min(states.max(1))) as f64
+        }
+    };
+    // The tractions of every turning point of a history (three fields),
+    // kept by the solve for the stresses whichever states are chosen:
+    // 49 MB for 1000 fretting cycles at 32², measured 91 MB peak with the
+    // default `last_cycle` (issue #59).
+    let turning = specs
+        .clone()
+        .filter_map(|s| s.history.as_ref().map(|h| h.turning_points(&s.load).len()))
+        .max()
+        .unwrap_or(0);
+    kernels
+        + cells * (256.0 + 8.0 * (planes + 1.0) + 24.0 * turning as f64)
+        + states.max(1) as f64 * state
+        + sliced
 }
 
 /// The materials of a sweep's `specs`, each with its first case and its
@@ -80,19 +111,35 @@ pub fn sweep_materials<'a>(
     materials
 }
 
-/// The most states a case of `cases` has its stresses computed at (the
-/// turning points of a load history with `stress.states = "turning"`).
-fn stress_states<'a>(
-    cfg: &crate::config::StressCfg,
+/// The states a case `spec` has its stresses computed at: those of its
+/// load history's turning points `stress.states` chooses, else one.
+pub fn stress_states(cfg: &crate::config::StressCfg, spec: &solver::CaseSpec) -> usize {
+    match &spec.history {
+        Some(h) => cfg
+            .chosen_states()
+            .count(h.turning_points(&spec.load).len()),
+        None => 1,
+    }
+}
+
+/// What a stressed history's states add to a memory refusal's subject:
+/// their number and the key that chooses them (empty for a few states).
+pub fn stress_states_note<'a>(
+    cfg: Option<&crate::config::StressCfg>,
     specs: impl Iterator<Item = &'a solver::CaseSpec>,
-) -> usize {
-    specs
-        .map(|s| match (&s.history, cfg.states.as_str()) {
-            (Some(h), "turning") => h.turning_points(&s.load).len(),
-            _ => 1,
-        })
-        .max()
-        .unwrap_or(1)
+) -> String {
+    use solver::stress_summary::LAST_CYCLE_TURNING;
+    let Some(cfg) = cfg else {
+        return String::new();
+    };
+    let states = specs.map(|s| stress_states(cfg, s)).max().unwrap_or(1);
+    if states <= LAST_CYCLE_TURNING {
+        return String::new();
+    }
+    format!(
+        ", with [stress] at {states} states of its load history (stress.states = \"{}\"; \"last_cycle\" computes {LAST_CYCLE_TURNING})",
+        cfg.states
+    )
 }
 
 /// `MemAvailable` of `/proc/meminfo`, bytes; `None` where it cannot be read.
@@ -158,6 +205,46 @@ mod tests {
         // doubling it.
         let at512 = worker_bytes(512, 1);
         assert!((131.2e6..1.5 * 131.2e6).contains(&at512), "{at512}");
+    }
+
+    /// Issue #59 item 8: 1000 fretting cycles at 32² with `[stress]` at
+    /// every turning point were killed at 8.7 GB (check: 396 MB). The
+    /// estimate counts the 2002 states (each state's planes and slices,
+    /// a batch's slice transforms, the history's turning tractions), a
+    /// machine with less is refused naming `stress.states`, and the
+    /// default `last_cycle` computes three. (Measured peaks against these
+    /// estimates: docs/performance.md, "A long stressed history".)
+    #[test]
+    fn issue59_a_stressed_history_is_priced_per_state_and_refused_by_its_key() {
+        let text = |states: &str| {
+            format!("[grid]\npoints = 32\nspacing_um = 8.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.28571\n[sweep]\nmaterials = [\"Fe\"]\nangles_deg = [0.0]\n[history]\nfretting = {{ amplitude_ratio = 0.6, cycles = 1000 }}\nsteps_per_segment = 1\n[stress]\ndepths_um = [10.0]\n{states}")
+        };
+        let estimate = |states: &str| {
+            let c = crate::config::Config::parse(&text(states), &[]).unwrap();
+            let spec = crate::solve::CaseChoice::new(&c, None, None, None)
+                .unwrap()
+                .spec;
+            let cfg = c.stress.unwrap();
+            let bytes = stress_bytes(32, &cfg, std::iter::once(&spec));
+            (
+                bytes,
+                stress_states_note(Some(&cfg), std::iter::once(&spec)),
+            )
+        };
+        let (all, note) = estimate("states = \"turning\"\n");
+        let (last, quiet) = estimate("");
+        // 2002 states of 0.32 MB (planes, slices), 16 of 3.9 MB sliced
+        // at once, 49 MB of turning tractions: 0.7 GB.
+        assert!((0.6e9..0.8e9).contains(&all), "{all}");
+        assert!(last < 0.1e9, "{last}");
+        assert!(quiet.is_empty());
+        let e = check_fits(&format!("this case{note}"), all, 1, Some(0.5 * GIB))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("with [stress] at 2002 states of its load history (stress.states = \"turning\"; \"last_cycle\" computes 3)"),
+            "{e}"
+        );
     }
 
     #[test]

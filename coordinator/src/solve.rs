@@ -286,7 +286,11 @@ impl Solved {
 pub fn solve_in_memory(case: CaseChoice, threads: usize) -> Result<Solved> {
     let spec = &case.spec;
     crate::memory::check_fits(
-        &format!("this case ({0} x {0} cells)", spec.grid.n),
+        &format!(
+            "this case ({0} x {0} cells{1})",
+            spec.grid.n,
+            crate::memory::stress_states_note(case.stress.as_ref(), std::iter::once(spec))
+        ),
         crate::memory::worker_bytes(spec.grid.n, 1)
             + case.stress.as_ref().map_or(0.0, |cfg| {
                 crate::memory::stress_bytes(spec.grid.n, cfg, std::iter::once(spec))
@@ -534,5 +538,42 @@ indenters = ["steel", "rigid"]
         let json = std::fs::read_to_string(dir.join("case.json")).unwrap();
         assert!(!json.contains("\"stress\"") && !dir.join("stress").exists());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Issue #59 item 8: a long fretting history computes its stresses at
+    /// the turning points of its last cycle by default (+A → −A → +A: what
+    /// Crossland over the steady cycle reads), every turning point with
+    /// `states = "turning"`; the last cycle's states are the same bits in
+    /// both, and `check`'s memory and time estimates count the states.
+    #[test]
+    fn issue59_a_long_history_stresses_its_last_cycle_by_default() {
+        let base = "[grid]\npoints = 32\nspacing_um = 10.0\n[indenter]\nradius_mm = 18.0\n[load]\nnormal_n = 20.0\nfriction = 0.28571\n[sweep]\nmaterials = [\"Fe\"]\nangles_deg = [0.0]\n[history]\nfretting = { amplitude_ratio = 0.6, cycles = 3 }\nsteps_per_segment = 1\n[stress]\ndepths_um = [10.0]\nslice_rows = 4\n";
+        let solve = |extra: &str| {
+            let c = Config::parse(&format!("{base}{extra}"), &[]).unwrap();
+            let cfg = c.stress.clone().unwrap();
+            let choice = CaseChoice::new(&c, None, None, None).unwrap();
+            let spec = choice.spec.clone();
+            let solved = solve_in_memory(choice, 1).unwrap();
+            (cfg, spec, solved.stress.unwrap())
+        };
+        let (last_cfg, spec, last) = solve("");
+        let (all_cfg, _, all) = solve("states = \"turning\"\n");
+        let steps = |s: &crate::output::stress::StressOutput| -> Vec<Option<usize>> {
+            s.scalars.states.iter().map(|st| st.step).collect()
+        };
+        // 0 → +A, then three cycles of two segments: 8 turning points.
+        assert_eq!(steps(&all), (0..8).map(Some).collect::<Vec<_>>());
+        assert_eq!(steps(&last), vec![Some(5), Some(6), Some(7)]);
+        assert_eq!(last.scalars.states[..], all.scalars.states[5..]);
+        let (n, one) = (spec.grid.n, std::iter::once(&spec));
+        let per_state = crate::memory::stress_bytes(n, &all_cfg, one.clone())
+            - crate::memory::stress_bytes(n, &last_cfg, one);
+        assert!(per_state > 0.0);
+        let t_all = crate::cost::stress_seconds(&spec, &all_cfg);
+        let t_last = crate::cost::stress_seconds(&spec, &last_cfg);
+        assert!(
+            (t_all / t_last - 8.0 / 3.0).abs() < 1e-12,
+            "{t_all} {t_last}"
+        );
     }
 }

@@ -53,8 +53,9 @@
 //!    grid), `self_affine` (random surfaces), `presets`, `radii` (what an
 //!    apparent radius is), `spec`
 //! 4. `operators/`, kernels and operators: `fft2`, `operator`, `multilevel`
-//!    (coarse tables), `stress` (depth kernels of the stresses below the
-//!    surface), `kernels` (a kernel's identity, store and build)
+//!    (coarse tables), `stress` (a folder: the stresses below the surface,
+//!    their depth kernels and the criteria of a point's states), `kernels`
+//!    (a kernel's identity, store and build)
 //! 5. `solve/`, the solvers: `normal`; `tangential_problem` (the tangential
 //!    solve's inputs and outputs) and `fista` (the shared momentum step) →
 //!    `coarse_slip` → `window` → `tangential`, `tangential_displacement`

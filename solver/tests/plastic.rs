@@ -634,7 +634,7 @@ fn a_crystal_an_elastic_ball_and_the_stresses_see_the_cap() {
                 slices: false,
                 slice_depth_m: None,
                 slice_rows: 2,
-                turning_states: false,
+                states: solver::stress_summary::StressStates::Final,
                 crossland_alpha: 0.0,
             };
             let st = solver::stress_summary::compute(

@@ -9,7 +9,9 @@ mod stress_closed_forms;
 
 use solver::stress::{peak, tresca, von_mises, Line, StressField, StressPlan};
 use solver::{Grid, Material};
-use stress_closed_forms::{cerruti, hamilton_normal, sliding_tangential, trailing_edge_sxx};
+use stress_closed_forms::{
+    boussinesq, cerruti, hamilton_normal, sliding_tangential, trailing_edge_sxx,
+};
 
 const A: f64 = 100e-6;
 const P0: f64 = 1e9;
@@ -750,4 +752,155 @@ fn sliding_512() {
     let worst = sliding_error(512, 0.3, &[0.0, 0.1, 0.25, 0.5, 1.0], 2);
     println!("worst over depths {worst:e} p0");
     assert!(worst < 5e-3, "worst {worst:e} p0");
+}
+
+/// The stress at `(x, y, z)` of the cell tractions `p` and `qx` on `grid`
+/// (Pa, z below the surface in m), each cell's force spread on 4x4
+/// points: Boussinesq's and Cerruti's point forces summed.
+fn point_force_sum(grid: &Grid, p: &[f64], qx: &[f64], at: [f64; 3], nu: f64) -> [f64; 6] {
+    let n = grid.n;
+    let (sub, da) = (4, grid.cell_area());
+    let mut acc = [0.0; 6];
+    for iy in 0..n {
+        for ix in 0..n {
+            let i = iy * n + ix;
+            if p[i] == 0.0 && qx[i] == 0.0 {
+                continue;
+            }
+            let (fz, fx) = (p[i] * da / 16.0, qx[i] * da / 16.0);
+            for sy in 0..sub {
+                for sx in 0..sub {
+                    let x = grid.x(ix) + grid.dx * ((sx as f64 + 0.5) / sub as f64 - 0.5);
+                    let y = grid.y(iy) + grid.dy * ((sy as f64 + 0.5) / sub as f64 - 0.5);
+                    let (u, v) = (at[0] - x, at[1] - y);
+                    let b = boussinesq(u, v, at[2], nu);
+                    let c = cerruti(u, v, at[2], nu);
+                    for k in 0..6 {
+                        acc[k] += fz * b[k] + fx * c[k];
+                    }
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// Boussinesq's field, the reference below, checked on its own: the
+/// resultant through a plane is the force (`∫σzz dA = −1`, rings in
+/// closed form), and far from a Hertz contact Hamilton's exact field is
+/// that of the resultant `2π/3 p0 a²` at the centre, all six components
+/// within the `(a/R)²` of the spread load.
+#[test]
+fn boussinesq_reference_carries_the_force_and_is_hamiltons_far_field() {
+    let nu = 0.3;
+    let z = 0.9;
+    let gl = stress_closed_forms::gauss_legendre(40);
+    let mut flux = 0.0;
+    for piece in 0..60 {
+        let (ra, rb) = (piece as f64 * 0.5, (piece + 1) as f64 * 0.5);
+        for &(u, w) in &gl {
+            let r = 0.5 * (ra + rb) + 0.5 * (rb - ra) * u;
+            flux += 0.5 * (rb - ra) * w * r * boussinesq(r, 0.0, z, nu)[2] * std::f64::consts::TAU;
+        }
+    }
+    // Beyond r = 30: −(3z³/2π) 2π ∫ r/(r² + z²)^{5/2} dr = −z³ (r² + z²)^{−3/2}.
+    flux -= z * z * z / (30.0f64 * 30.0 + z * z).powf(1.5);
+    println!("Boussinesq: ∫σzz dA over z = {z}: {flux:.12} (−1)");
+    assert!((flux + 1.0).abs() < 1e-9);
+    let mut worst = 0.0_f64;
+    for &(x, y, z) in &[(3.0, 1.0, 5.0), (-6.0, 2.0, 4.0), (0.5, -0.2, 8.0)] {
+        let far = hamilton_normal(x, y, z, nu);
+        let point = boussinesq(x, y, z, nu).map(|v| v * 2.0 * std::f64::consts::PI / 3.0);
+        let size = far.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let r2 = x * x + y * y + z * z;
+        for c in 0..6 {
+            worst = worst.max((far[c] - point[c]).abs() / size * r2);
+        }
+    }
+    println!(
+        "Boussinesq against Hamilton far away: largest difference {worst:.2} (a/R)² of the field"
+    );
+    assert!(worst < 2.0);
+}
+
+/// Issue #59 item 7: the stresses of tractions confined to the domain at
+/// depths from 0.1a to many domain widths, on the window's centre and two
+/// cells off it. A Hertz pressure and, as a second state, a Hertz shear
+/// along x, 64² over 4a (the padded period T = 8a): against Hamilton's
+/// fields (the normal and, integrated, the sliding one) to a, and from a
+/// down against Boussinesq's and Cerruti's point forces summed over the
+/// cells, all six components, relative to p0 to a and below it to the
+/// point force's `σzz` on its axis.
+/// Before, the periodic images of the padded grid's wider lattice were
+/// left in: σzz under the pressure fell to a constant `−P/(16T²)`, 3× the
+/// point force's at 5T and 2e4× at 1250T.
+#[test]
+fn deep_planes_carry_boussinesq_and_cerruti_fields_to_a_thousand_domain_widths() {
+    let (nu, n) = (0.3, 64);
+    let (grid, p, q, zero) = hertz(n, 4.0, 1.0);
+    let mut plan = StressPlan::new(&fe(), grid).unwrap();
+    let states = [
+        plan.tractions(&p, &zero, &zero),
+        plan.tractions(&zero, &q, &zero),
+    ];
+    let cells = [(n / 2, n / 2), (n / 2 + 9, n / 2 - 5), (3, n - 7)];
+    let mut worst_shallow = 0.0_f64;
+    let mut worst_deep = 0.0_f64;
+    for z in [0.1, 0.5, 1.0, 2.0, 4.0, 8.0, 20.0, 40.0, 100.0, 1e3, 1e4] {
+        let plane = plan.plane(z * A).unwrap();
+        for (s, t) in states.iter().enumerate() {
+            let got = plan.apply(&plane, t);
+            let wants: Vec<[f64; 6]> = cells
+                .iter()
+                .map(|&(ix, iy)| {
+                    let (x, y) = (grid.x(ix), grid.y(iy));
+                    if z <= 1.0 {
+                        let f = if s == 0 {
+                            hamilton_normal(x / A, y / A, z, nu)
+                        } else {
+                            sliding_tangential(x / A, y / A, z, nu, 16)
+                        };
+                        f.map(|v| v * P0)
+                    } else {
+                        let (pp, qq) = if s == 0 { (&p, &zero) } else { (&zero, &q) };
+                        point_force_sum(&grid, pp, qq, [x, y, z * A], nu)
+                    }
+                })
+                .collect();
+            // The scale: p0 to a deep, then the point force's σzz on its
+            // axis, 3F/(2πz²) (within the window a shear's field is
+            // smaller still: Cerruti's vanishes on the axis).
+            let force = if s == 0 { &p } else { &q }.iter().sum::<f64>() * grid.cell_area();
+            let size = if z <= 1.0 {
+                P0
+            } else {
+                3.0 * force / (std::f64::consts::TAU * (z * A).powi(2))
+            };
+            let mut err = 0.0_f64;
+            for (&(ix, iy), want) in cells.iter().zip(&wants) {
+                for (c, w) in want.iter().enumerate() {
+                    err = err.max((got.components[c][iy * n + ix] - w).abs() / size);
+                    if std::env::var("DEBUG_DEEP").is_ok() {
+                        println!(
+                            "  z {z} s {s} cell {ix},{iy} c {c}: got {:.6e} want {:.6e}",
+                            got.components[c][iy * n + ix],
+                            w
+                        );
+                    }
+                }
+            }
+            println!(
+                "{} at z = {z} a ({:.3} T): largest error {err:.1e} of the stress scale",
+                ["pressure", "shear"][s],
+                z / 8.0
+            );
+            if z <= 1.0 {
+                worst_shallow = worst_shallow.max(err);
+            } else {
+                worst_deep = worst_deep.max(err);
+            }
+        }
+    }
+    assert!(worst_shallow < 2e-3, "{worst_shallow:e}");
+    assert!(worst_deep < 1e-4, "{worst_deep:e}");
 }

@@ -214,7 +214,7 @@ impl Config {
         self.sweep.check_unique(&self.sweep.angles_deg.values()?)?;
         self.convergence.check()?;
         if let Some(s) = &self.stress {
-            s.check()?;
+            s.check(&self.grid)?;
         }
         let amplitude = self.sweep.amplitude_axis()[0];
         match &self.history {

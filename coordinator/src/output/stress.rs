@@ -81,12 +81,23 @@ pub struct StressArray {
 /// over the surface). The files of [`write`] and Python's
 /// `Result.stress`.
 pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
+    let mut out = Vec::new();
+    each_array(so, |arr| {
+        out.push(arr);
+        Ok(())
+    })
+    .expect("collecting fails nowhere");
+    out
+}
+
+/// [`arrays`] one at a time to `f` (the first error stops it): [`write`]
+/// holds one array, not a copy of every state's fields.
+fn each_array(so: &StressOutput, mut f: impl FnMut(StressArray) -> Result<()>) -> Result<()> {
     let n = so.grid.n;
     let rows = so.scalars.slice_depths_m.len();
     let many = so.states.len() > 1;
-    let mut out = Vec::new();
     let mut push = |name: String, rows: usize, data: Vec<f64>| {
-        out.push(StressArray {
+        f(StressArray {
             name,
             rows,
             cols: n,
@@ -98,10 +109,10 @@ pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
         for (k, f) in st.planes.iter().enumerate() {
             let stem = format!("plane_{}um{suffix}", fmt_f64(so.depths_um[k]));
             for (c, name) in COMPONENTS.iter().enumerate() {
-                push(format!("{stem}_{name}"), n, f.components[c].clone());
+                push(format!("{stem}_{name}"), n, f.components[c].clone())?;
             }
             for (name, g) in DERIVED {
-                push(format!("{stem}_{name}"), n, f.map(g));
+                push(format!("{stem}_{name}"), n, f.map(g))?;
             }
         }
         for (label, lines) in [("along", &st.along), ("across", &st.across)] {
@@ -111,14 +122,14 @@ pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
             let stem = format!("slice_{label}{suffix}");
             for (c, name) in COMPONENTS.iter().enumerate() {
                 let vals = lines.iter().flat_map(|f| f.components[c].clone()).collect();
-                push(format!("{stem}_{name}"), rows, vals);
+                push(format!("{stem}_{name}"), rows, vals)?;
             }
             for (name, g) in DERIVED {
                 push(
                     format!("{stem}_{name}"),
                     rows,
                     lines.iter().flat_map(|f| f.map(g)).collect(),
-                );
+                )?;
             }
         }
     }
@@ -127,14 +138,13 @@ pub fn arrays(so: &StressOutput) -> Vec<StressArray> {
             format!("plane_{}um_crossland", fmt_f64(so.depths_um[k])),
             n,
             f.clone(),
-        );
+        )?;
     }
     if let Some([al, ac]) = &so.crossland_slices {
-        push("slice_along_crossland".into(), rows, al.clone());
-        push("slice_across_crossland".into(), rows, ac.clone());
+        push("slice_along_crossland".into(), rows, al.clone())?;
+        push("slice_across_crossland".into(), rows, ac.clone())?;
     }
-    push("surface_swt".into(), n, so.swt_surface.clone());
-    out
+    push("surface_swt".into(), n, so.swt_surface.clone())
 }
 
 fn state_suffix(many: bool, step: Option<usize>) -> String {
@@ -151,14 +161,14 @@ fn state_suffix(many: bool, step: Option<usize>) -> String {
 pub fn write(dir: &Path, so: &StressOutput, title: &str) -> Result<Vec<String>> {
     let dir = dir.join("stress");
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("cannot create {}: {e}", dir.display()))?;
-    for arr in arrays(so) {
+    each_array(so, |arr| {
         super::npy::write_npy_2d(
             &dir.join(format!("{}.npy", arr.name)),
             arr.rows,
             arr.cols,
             &arr.data,
-        )?;
-    }
+        )
+    })?;
     let n = so.grid.n;
     let many = so.states.len() > 1;
     let mut warnings = Vec::new();

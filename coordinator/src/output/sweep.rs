@@ -986,8 +986,8 @@ pub fn write_result_fields(
 /// `fields/<case>/stress/` (the layout of `mpcontact solve`'s `stress/`),
 /// recomputed here from the returned tractions with the function the
 /// worker ran. A load history's turning states do not travel with the
-/// fields: for those (`stress.states = "turning"`) nothing is written and
-/// the returned note says so.
+/// fields: for those (`stress.states = "last_cycle"` or `"turning"`)
+/// nothing is written and the returned note says so.
 pub fn write_stress_fields(
     out_dir: &Path,
     key: &CaseKey,
@@ -996,7 +996,8 @@ pub fn write_stress_fields(
     scalars: &CaseScalars,
     (names, field_bytes): (&[String], &[u8]),
 ) -> anyhow::Result<Option<String>> {
-    if spec.history.is_some() && cfg.states == "turning" {
+    if spec.history.is_some() && cfg.chosen_states() != solver::stress_summary::StressStates::Final
+    {
         return Ok(Some(format!(
             "{key}: stress fields of a load history's turning states are not written by sweeps (its scalars are); `mpcontact solve` writes them"
         )));

@@ -149,7 +149,13 @@ pub fn run_sweep(args: &RunArgs) -> anyhow::Result<RunSummary> {
         crate::memory::stress_bytes(n, cfg, plan.cases.iter().map(|c| &c.spec))
     });
     crate::memory::check_fits(
-        "the sweep",
+        &format!(
+            "the sweep{}",
+            crate::memory::stress_states_note(
+                args.config.stress.as_ref(),
+                plan.cases.iter().map(|c| &c.spec)
+            )
+        ),
         crate::memory::worker_bytes(n, kernels.len()) + stress_bytes,
         args.workers,
         crate::memory::available_bytes(),

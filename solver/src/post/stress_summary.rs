@@ -5,25 +5,14 @@
 //! parameter), and the maxima, Crossland's and Smith–Watson–Topper's
 //! parameters. Shared by `mpcontact solve`, the Python module and the
 //! sweep's workers, so the three give the same numbers to the bit. The
-//! stresses themselves are [`crate::operators::stress`].
-//!
-//! ```
-//! use solver::stress_summary::swt_point;
-//! // Uniaxial σxx = ±σa on an isotropic surface: SWT = σa²/E on the plane
-//! // whose normal is x.
-//! let (e, nu, sa) = (200e9, 0.3, 100e6);
-//! let c = solver::Isotropic::new(e, nu).unwrap().stiffness();
-//! let s = c.try_inverse().unwrap();
-//! let at = swt_point(&[[sa, 0.0, 0.0, 0.0, 0.0, 0.0], [-sa, 0.0, 0.0, 0.0, 0.0, 0.0]], &s);
-//! assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12);
-//! assert_eq!(at.angle_deg, 0.0);
-//! ```
+//! stresses themselves, and the criteria of one point's states, are
+//! [`crate::operators::stress`].
 
-use nalgebra::Matrix6;
 use serde::{Deserialize, Serialize};
 
 use crate::operators::stress::{
-    principal, tresca_of, von_mises, Line, StressField, StressPlan, StressPlane,
+    crossland_at, principal, swt_point, tresca_of, von_mises, Line, StressField, StressPlan,
+    StressPlane,
 };
 use crate::{CaseScalars, CaseSpec, Fields, Grid, Material, SolverError, TurningState};
 
@@ -36,9 +25,6 @@ pub const MAXIMA_DEFINITION: &str = "maxima over the points computed: every plan
 /// How the Smith–Watson–Topper parameter is formed.
 pub const SWT_DEFINITION: &str = "Smith-Watson-Topper at the surface (z = 0, every cell of the grid): SWT = sigma_n,max * eps_a on the planes normal to the surface, their normal n = (cos t, sin t, 0) for t = 0, 1, ..., 179 degrees; sigma_n = n.sigma.n of each state, eps_n = n.eps.n with eps = C^-1 sigma (the substrate's compliance); over the states computed (a load history's turning points) sigma_n,max is the largest sigma_n and eps_a half the range of eps_n; a single state is taken as a cycle from the unloaded surface to that state and back (sigma_n,max = max(sigma_n, 0), eps_a = |eps_n| / 2); SWT = 0 where sigma_n,max <= 0; the critical plane is the t of the largest SWT";
 
-/// Directions of the critical-plane search (one per degree over a half turn).
-pub const SWT_DIRECTIONS: usize = 180;
-
 /// What to compute (the solver's form of `[stress]`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StressRequest {
@@ -50,11 +36,51 @@ pub struct StressRequest {
     pub slice_depth_m: Option<f64>,
     /// Rows of a slice (≥ 2), the surface included.
     pub slice_rows: usize,
-    /// With a load history: every turning point (`true`) or the final
-    /// increment only.
-    pub turning_states: bool,
+    /// With a load history, the states computed.
+    pub states: StressStates,
     /// Crossland's coefficient α.
     pub crossland_alpha: f64,
+}
+
+/// The states of a load history whose stresses are computed (a case
+/// without a history has one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StressStates {
+    /// Every turning point of the path, the start included: one state per
+    /// segment, 2002 for 1000 fretting cycles (issue #59: 8.7 GB at 32²).
+    Turning,
+    /// The turning points of the last cycle, the last
+    /// [`LAST_CYCLE_TURNING`] (+A → −A → +A of a fretting path): the
+    /// states of the cycle Crossland's and SWT's parameters are read over.
+    LastCycle,
+    /// The final increment only.
+    Final,
+}
+
+/// Turning points of one cycle: out, back and out again.
+pub const LAST_CYCLE_TURNING: usize = 3;
+
+impl StressStates {
+    /// The turning points of a path's `turning` whose stresses are
+    /// computed (none: the final increment is the one state).
+    pub fn chosen<T>(self, turning: &[T]) -> &[T] {
+        match self {
+            StressStates::Turning => turning,
+            StressStates::LastCycle => &turning[turning.len().saturating_sub(LAST_CYCLE_TURNING)..],
+            StressStates::Final => &[],
+        }
+    }
+
+    /// The states computed of a path of `turning` turning points (at
+    /// least the one final state).
+    pub fn count(self, turning: usize) -> usize {
+        match self {
+            StressStates::Turning => turning,
+            StressStates::LastCycle => turning.min(LAST_CYCLE_TURNING),
+            StressStates::Final => 1,
+        }
+        .max(1)
+    }
 }
 
 /// A value and its place (m; z into the body).
@@ -202,113 +228,6 @@ fn centroid(grid: &crate::Grid, p: &[f64]) -> (usize, usize) {
     (r(sx), r(sy))
 }
 
-/// SWT at one surface point over its states: the critical plane's value,
-/// angle, σn,max and εa (see [`SWT_DEFINITION`]). `compliance` is `C⁻¹`
-/// in Voigt order xx, yy, zz, yz, xz, xy with engineering shear strains.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SwtPoint {
-    /// SWT, Pa.
-    pub value: f64,
-    /// Normal of the critical plane from x, degrees.
-    pub angle_deg: f64,
-    /// σn,max, Pa.
-    pub sigma_max: f64,
-    /// εa.
-    pub strain_amplitude: f64,
-}
-
-/// SWT of the states `states` at one point (see [`SWT_DEFINITION`]).
-pub fn swt_point(states: &[[f64; 6]], compliance: &Matrix6<f64>) -> SwtPoint {
-    let strains: Vec<[f64; 6]> = states
-        .iter()
-        .map(|s| {
-            let v = compliance * nalgebra::Vector6::from_column_slice(s);
-            [v[0], v[1], v[2], v[3], v[4], v[5]]
-        })
-        .collect();
-    swt_of_strains(states, &strains)
-}
-
-/// `(cos² t, sin² t, sin t cos t)` of the SWT planes' normals, made once
-/// (a sine and cosine per direction and cell were a tenth of a sweep's
-/// time with `[stress]`).
-fn swt_directions() -> &'static [(f64, f64, f64); SWT_DIRECTIONS] {
-    static TABLE: std::sync::OnceLock<[(f64, f64, f64); SWT_DIRECTIONS]> =
-        std::sync::OnceLock::new();
-    TABLE.get_or_init(|| {
-        std::array::from_fn(|k| {
-            let deg = k as f64 * 180.0 / SWT_DIRECTIONS as f64;
-            let (s, c) = deg.to_radians().sin_cos();
-            (c * c, s * s, s * c)
-        })
-    })
-}
-
-fn swt_of_strains(states: &[[f64; 6]], strains: &[[f64; 6]]) -> SwtPoint {
-    let mut best = SwtPoint {
-        value: 0.0,
-        angle_deg: 0.0,
-        sigma_max: 0.0,
-        strain_amplitude: 0.0,
-    };
-    let single = states.len() == 1;
-    for (k, &(cc, ss, sc)) in swt_directions().iter().enumerate() {
-        let deg = k as f64 * 180.0 / SWT_DIRECTIONS as f64;
-        let (mut smax, mut emax, mut emin) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::INFINITY);
-        for (t, e) in states.iter().zip(strains) {
-            smax = smax.max(t[0] * cc + t[1] * ss + 2.0 * t[5] * sc);
-            // engineering shear strain: ε_n = εxx c² + εyy s² + γxy s c
-            let en = e[0] * cc + e[1] * ss + e[5] * sc;
-            emax = emax.max(en);
-            emin = emin.min(en);
-        }
-        let (sigma_max, amp) = if single {
-            (smax.max(0.0), 0.5 * emax.abs())
-        } else {
-            (smax, 0.5 * (emax - emin))
-        };
-        let value = if sigma_max > 0.0 {
-            sigma_max * amp
-        } else {
-            0.0
-        };
-        if value > best.value {
-            best = SwtPoint {
-                value,
-                angle_deg: deg,
-                sigma_max,
-                strain_amplitude: amp,
-            };
-        }
-    }
-    best
-}
-
-/// Crossland's parameter of a point's states (see [`CROSSLAND_DEFINITION`]).
-fn crossland_at(ts: &[[f64; 6]], alpha: f64) -> f64 {
-    let dev = |t: &[f64; 6]| {
-        let m = (t[0] + t[1] + t[2]) / 3.0;
-        [t[0] - m, t[1] - m, t[2] - m, t[3], t[4], t[5]]
-    };
-    let mut amp: f64 = 0.0;
-    for i in 0..ts.len() {
-        for j in i + 1..ts.len() {
-            let (a, b) = (dev(&ts[i]), dev(&ts[j]));
-            let d: [f64; 6] = std::array::from_fn(|k| 0.5 * (a[k] - b[k]));
-            let j2 = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                + d[3] * d[3]
-                + d[4] * d[4]
-                + d[5] * d[5];
-            amp = amp.max(j2.sqrt());
-        }
-    }
-    let sh = ts
-        .iter()
-        .map(|t| (t[0] + t[1] + t[2]) / 3.0)
-        .fold(f64::NEG_INFINITY, f64::max);
-    amp + alpha * sh
-}
-
 /// Bytes of depth kernels a worker keeps between cases, over all its
 /// materials: 512 MiB, 13 planes at 256², 3 at 512² (576 B a cell, see
 /// [`StressPlane::bytes`]); the current material's first plane (its
@@ -425,8 +344,8 @@ fn resolve<'a>(r: &'a PlaneRef, kept: &'a [StressPlane]) -> &'a StressPlane {
 }
 
 /// Computes the stresses `req` asks for on the states of a solved case:
-/// the turning points of its load history (or its final state), else the
-/// case's one state; and the scalars.
+/// the turning points of its load history `req.states` chooses (or its
+/// final state), else the case's one state; and the scalars.
 pub fn compute(
     req: &StressRequest,
     spec: &CaseSpec,
@@ -449,8 +368,9 @@ pub fn compute_with(
 ) -> Result<CaseStress, SolverError> {
     let grid = spec.grid;
     let n = grid.n;
-    let states: Vec<StateTractions> = if req.turning_states && !turning.is_empty() {
-        turning
+    let chosen = req.states.chosen(turning);
+    let states: Vec<StateTractions> = if !chosen.is_empty() {
+        chosen
             .iter()
             .map(|t| (Some(t.step), &t.p[..], &t.qx[..], &t.qy[..]))
             .collect()
@@ -705,69 +625,4 @@ pub fn compute_with(
         contact_radius_m: a,
         p_h,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn compliance(e: f64, nu: f64) -> Matrix6<f64> {
-        crate::Isotropic::new(e, nu)
-            .unwrap()
-            .stiffness()
-            .try_inverse()
-            .unwrap()
-    }
-
-    /// Uniaxial cyclic surface stress σxx = ±σa: by hand, on the plane of
-    /// normal (cos t, sin t), σn = σ cos²t and εn = σ (cos²t − ν sin²t)/E;
-    /// σn,max εa = σa² cos²t (cos²t − ν sin²t)/E, largest at t = 0: σa²/E.
-    #[test]
-    fn uniaxial_cycle_gives_sigma_a_squared_over_e_on_the_plane_normal_to_x() {
-        let (e, nu, sa) = (210e9, 0.3, 300e6);
-        let s = compliance(e, nu);
-        let at = swt_point(&[[sa, 0., 0., 0., 0., 0.], [-sa, 0., 0., 0., 0., 0.]], &s);
-        assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12, "{at:?}");
-        assert_eq!(at.angle_deg, 0.0);
-        assert!((at.sigma_max / sa - 1.0).abs() < 1e-12);
-        assert!((at.strain_amplitude / (sa / e) - 1.0).abs() < 1e-12);
-        // The same state turned by 30° about z: the critical plane turns with it.
-        let (sn, cs) = 30f64.to_radians().sin_cos();
-        let r = [sa * cs * cs, sa * sn * sn, 0., 0., 0., sa * sn * cs];
-        let m = r.map(|v| -v);
-        let at = swt_point(&[r, m], &s);
-        assert!((at.value / (sa * sa / e) - 1.0).abs() < 1e-12);
-        assert!((at.angle_deg - 30.0).abs() < 1e-9, "{at:?}");
-    }
-
-    /// One state: the cycle from the unloaded surface to it and back,
-    /// σn,max = σ, εa = σ/(2E) on the plane normal to x.
-    #[test]
-    fn a_single_state_cycles_from_the_unloaded_surface() {
-        let (e, nu, sg) = (200e9, 0.25, 100e6);
-        let at = swt_point(&[[sg, 0., 0., 0., 0., 0.]], &compliance(e, nu));
-        assert!((at.value / (sg * sg / (2.0 * e)) - 1.0).abs() < 1e-12);
-        // Pure compression never opens a crack: 0.
-        let at = swt_point(&[[-sg, -sg, -sg, 0., 0., 0.]], &compliance(e, nu));
-        assert_eq!(at.value, 0.0);
-    }
-
-    /// A mean tension shifts σmax, not εa: σxx between σm − σa and σm + σa
-    /// gives (σm + σa) σa / E.
-    #[test]
-    fn a_mean_stress_raises_sigma_max_only() {
-        let (e, nu, sm, sa) = (150e9, 0.33, 80e6, 120e6);
-        let at = swt_point(
-            &[
-                [sm + sa, 0., 0., 0., 0., 0.],
-                [sm, 0., 0., 0., 0., 0.],
-                [sm - sa, 0., 0., 0., 0., 0.],
-            ],
-            &compliance(e, nu),
-        );
-        assert!(
-            (at.value / ((sm + sa) * sa / e) - 1.0).abs() < 1e-12,
-            "{at:?}"
-        );
-    }
 }

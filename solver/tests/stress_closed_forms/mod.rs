@@ -187,3 +187,35 @@ pub fn sliding_tangential(x: f64, y: f64, z: f64, nu: f64, rule: usize) -> [f64;
     }
     total
 }
+
+/// Boussinesq's point force: the stress at `(x, y, z)` (z into the body,
+/// tension positive, Voigt order xx, yy, zz, yz, xz, xy) of a unit force
+/// pressing the surface origin along +z (Johnson 1985, §3.2: σr, σθ, σz
+/// and τrz turned to x, y).
+pub fn boussinesq(x: f64, y: f64, z: f64, nu: f64) -> [f64; 6] {
+    let r2 = x * x + y * y;
+    let rho2 = r2 + z * z;
+    let rho = rho2.sqrt();
+    let rho3 = rho2 * rho;
+    let rho5 = rho3 * rho2;
+    let c = 1.0 / (2.0 * std::f64::consts::PI);
+    let sz = -3.0 * c * z * z * z / rho5;
+    let trz_over_r = -3.0 * c * z * z / rho5;
+    // (1 − z/ρ)/r² = 1/(ρ(ρ + z)), without the cancellation on the axis
+    let tail = 1.0 / (rho * (rho + z));
+    let sr_iso = c * (1.0 - 2.0 * nu) * tail;
+    let st = -c * (1.0 - 2.0 * nu) * (tail - z / rho3);
+    // σr = sr_iso − 3 c z r²/ρ⁵: its r² part goes with cos², sin², sin cos.
+    let b = -3.0 * c * z / rho5;
+    // σxx = σr cos² + σθ sin² = (sr_iso x² + σθ y²)/r² + b x², and alike;
+    // on the axis σr = σθ.
+    let (cc, ss, sc) = if r2 > 0.0 {
+        (x * x / r2, y * y / r2, x * y / r2)
+    } else {
+        (0.5, 0.5, 0.0)
+    };
+    let sxx = sr_iso * cc + st * ss + b * x * x;
+    let syy = sr_iso * ss + st * cc + b * y * y;
+    let sxy = (sr_iso - st) * sc + b * x * y;
+    [sxx, syy, sz, trz_over_r * y, trz_over_r * x, sxy]
+}
