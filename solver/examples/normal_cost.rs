@@ -126,7 +126,8 @@ fn main() {
     fe.history = Some(LoadHistory {
         tangential_ratios: vec![0.0, 0.6, -0.6, 0.6, -0.6, 0.6],
         normal_forces_n: None,
-        steps_per_segment: 10,
+        increments: solver::Increments::Fixed(10),
+        sampling: Default::default(),
         shifts_m: None,
         wear: None,
     });
