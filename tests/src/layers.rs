@@ -6,8 +6,8 @@
 //! It reads every `crate::…` path of a module's code — a module, a layer
 //! folder's module, a `{…}` group of either, or a name the crate root
 //! re-exports (`pub use folder::module::Name`) — and `super::…` between the
-//! files of a layer folder. `#[cfg(test)]` tests and comments are left out
-//! (tests may drive a whole case).
+//! files of a layer folder. `#[cfg(test)]` tests (a folder module's
+//! `tests.rs` too) and comments are left out (tests may drive a whole case).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -199,6 +199,10 @@ impl Layers {
 
 /// The code of a file without its tests and comments.
 fn code(path: &Path) -> String {
+    // A folder module's `tests.rs` is its `#[cfg(test)] mod tests;`.
+    if path.file_name().is_some_and(|n| n == "tests.rs") {
+        return String::new();
+    }
     let text = std::fs::read_to_string(path).unwrap();
     let text = match text.find("#[cfg(test)]") {
         Some(i) => &text[..i],

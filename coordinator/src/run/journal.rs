@@ -85,8 +85,9 @@ impl Entry {
 const HEADER_START: &str = "{\"kind\":\"header\"";
 
 /// The first protocol whose results hold the zones' own radii apart from
-/// μa's (issue #59): the journals of earlier ones do not resume.
-const RADII_SPLIT_VERSION: u32 = 7;
+/// μa's (issue #59; 7 was #61's resampled surfaces): the journals of
+/// earlier ones do not resume.
+const RADII_SPLIT_VERSION: u32 = 8;
 
 /// Refuses a journal at `path` written with `protocol_version` when its
 /// results cannot be read as this build's.
