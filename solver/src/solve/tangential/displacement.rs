@@ -28,7 +28,7 @@ use crate::operators::operator::Operator;
 use crate::solve::tangential::active_set::{
     active_set_under, slip_field, Condition, Controls, Feasible,
 };
-use crate::solve::tangential::fista::{self, Momentum};
+use crate::solve::tangential::fista::Momentum;
 use crate::solve::tangential::problem::{TangentialReport, TangentialSolution, TangentialStart};
 use crate::solve::tangential::window::{contact_window, WindowCache};
 
@@ -276,14 +276,12 @@ pub fn solve_displacement_on_grid(
                 (px[i], py[i]) = clip(yx[i] - step * sx[i], yy[i] - step * sy[i], bound(i));
             }
             // The gradient mapping (a slip) relative to the scale.
-            let (res, restart) = fista::mapping(&cells, (&yx, &yy), (&px, &py), (&qx, &qy));
-            report.change = res / step / scale;
-            momentum.advance(
-                restart,
+            report.change = momentum.finish(
                 &cells,
                 (&mut qx, &mut qy),
                 (&px, &py),
                 (&mut yx, &mut yy),
+                (step, scale),
             );
             if report.change < prob.tolerance {
                 report.converged = true;

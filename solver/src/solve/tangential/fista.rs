@@ -8,7 +8,7 @@
 /// `cells`: the largest |y − p| (a traction; divided by the step it is a
 /// slip), and whether the step went against the last move `p − q`, which
 /// restarts the momentum.
-pub(crate) fn mapping(
+fn mapping(
     cells: &[usize],
     (yx, yy): (&[f64], &[f64]),
     (px, py): (&[f64], &[f64]),
@@ -30,6 +30,22 @@ impl Momentum {
     /// t₁ = 1.
     pub(crate) fn new() -> Self {
         Momentum(1.0)
+    }
+
+    /// The end of a FISTA iteration that projected `y` to `p` with `step`:
+    /// the gradient mapping (a slip) relative to `scale`, which it returns,
+    /// then the momentum step ([`Momentum::advance`]) to the next `q`, `y`.
+    pub(crate) fn finish(
+        &mut self,
+        cells: &[usize],
+        (qx, qy): (&mut [f64], &mut [f64]),
+        (px, py): (&[f64], &[f64]),
+        (yx, yy): (&mut [f64], &mut [f64]),
+        (step, scale): (f64, f64),
+    ) -> f64 {
+        let (res, restart) = mapping(cells, (yx, yy), (px, py), (qx, qy));
+        self.advance(restart, cells, (qx, qy), (px, py), (yx, yy));
+        res / step / scale
     }
 
     /// Takes the projected point `p` as the new iterate `q` and extrapolates

@@ -30,7 +30,7 @@ use crate::solve::tangential::active_set::{
 };
 use crate::solve::tangential::cg::{cg_disc, fourier_pays, on_rim, sum_in_order, CgOutcome};
 use crate::solve::tangential::coarse_slip::{coarse_start, TangentialLevels};
-use crate::solve::tangential::fista::{self, Momentum};
+use crate::solve::tangential::fista::Momentum;
 pub use crate::solve::tangential::problem::{
     TangentialMethod, TangentialProblem, TangentialReport, TangentialSolution, TangentialStart,
 };
@@ -464,14 +464,12 @@ fn on_grid_taking(
         let shift_norm = (lambda[0].hypot(lambda[1]) / step)
             .max(prob.slip_floor)
             .max(f64::MIN_POSITIVE);
-        let (res, restart) = fista::mapping(&cells, (&yx, &yy), (&px, &py), (&qx, &qy));
-        report.change = res / step / shift_norm;
-        momentum.advance(
-            restart,
+        report.change = momentum.finish(
             &cells,
             (&mut qx, &mut qy),
             (&px, &py),
             (&mut yx, &mut yy),
+            (step, shift_norm),
         );
         if report.change < prob.tolerance {
             report.converged = true;
