@@ -354,11 +354,7 @@ pub fn write_solved(solved: &Solved, out: &Path) -> Result<()> {
             &c.spec.grid,
             &title,
         )?);
-        let increments = crate::output::history::history_warnings(h);
-        for w in crate::output::wear::wear_warnings(h)
-            .into_iter()
-            .chain(increments)
-        {
+        for w in crate::output::history::path_warnings(h, &title) {
             eprintln!("warning: {w}");
         }
     }

@@ -139,6 +139,9 @@ pub(super) struct Trial {
     /// The total tangential surface displacement at its end.
     pub(super) v: (Vec<f64>, Vec<f64>),
     pub(super) estimate: PathEstimate,
+    /// With a wear law, what each cell did over it (`each_cell`), which
+    /// its acceptance wears by; empty without.
+    pub(super) cells: Vec<CellIncrement>,
 }
 
 /// A load path as it is solved: the state after the last increment taken
@@ -329,6 +332,7 @@ impl<'a> Walk<'a> {
         // term (see `PathEstimate`).
         let (mut bound, mut swept, mut turned) = (0.0, 0.0, 0.0);
         let (q0x, q0y) = (&self.last.tangential.qx, &self.last.tangential.qy);
+        let mut cells = Vec::new();
         self.each_cell(&state, &v, |c| {
             let w = cell_work(c.q, c.ds);
             work += w;
@@ -359,6 +363,7 @@ impl<'a> Walk<'a> {
             }
             if let Some(law) = &wear {
                 worn = worn.max(law(c.p, c.q, c.ds));
+                cells.push(c);
             }
         });
         Ok(Trial {
@@ -371,6 +376,7 @@ impl<'a> Walk<'a> {
                 work_j: work * da,
                 worn_m: worn,
             },
+            cells,
         })
     }
 
@@ -448,23 +454,18 @@ impl<'a> Walk<'a> {
             load: (p_k, f_k),
             goal,
             state,
-            v: (mut vx, mut vy),
+            v: (vx, vy),
             estimate,
+            cells,
         } = trial;
         let shift = state.tangential.shift;
         // With a wear law, each cell wears by its slip increment with the
         // pressure and traction its dissipation is taken at (PHYSICS.md
-        // §5d; `each_cell`).
-        if self.wearing.is_some() {
-            let mut depths = Vec::with_capacity(len);
-            let v = (vx, vy);
-            self.each_cell(&state, &v, |c| depths.push(c));
-            (vx, vy) = v;
-            if let Some(w) = &mut self.wearing {
-                w.clear_increment();
-                for c in depths {
-                    w.wear_cell(c.i, c.p, c.q, c.ds);
-                }
+        // §5d; the trial's `each_cell`).
+        if let Some(w) = &mut self.wearing {
+            w.clear_increment();
+            for c in cells {
+                w.wear_cell(c.i, c.p, c.q, c.ds);
             }
         }
         // With a wear law, the cells' slips δt − u halfway through the
