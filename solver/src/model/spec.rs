@@ -376,6 +376,19 @@ impl LoadHistory {
         pts
     }
 
+    /// How segment `j` is split, the cycles looked at being `looked_at`
+    /// ([`looked_at_segments`]): fixed increments split every segment alike
+    /// (every loop is sampled); auto ones sample the loops of the cycles
+    /// looked at in `sampling.increments` fixed increments.
+    pub(crate) fn segment_increments(&self, j: usize, looked_at: &[usize]) -> Increments {
+        match self.increments {
+            Increments::Auto { .. } if self.sampling.increments > 0 && looked_at.contains(&j) => {
+                Increments::Fixed(self.sampling.increments)
+            }
+            split => split,
+        }
+    }
+
     /// The increments the path is expected to take (what `check` prices):
     /// fixed ones exactly; auto ones as the error estimate chose them on
     /// Table 1(a) Fe (docs/performance.md, "Increments chosen by the
@@ -392,13 +405,8 @@ impl LoadHistory {
         let total: usize = points
             .windows(2)
             .enumerate()
-            .map(|(j, w)| match self.increments {
+            .map(|(j, w)| match self.segment_increments(j, &looked_at) {
                 Increments::Fixed(k) => k,
-                Increments::Auto { .. }
-                    if self.sampling.increments > 0 && looked_at.contains(&j) =>
-                {
-                    self.sampling.increments
-                }
                 Increments::Auto { tolerance } => {
                     let (a, b) = (w[0], w[1]);
                     let dp = (b.0 / a.0).ln().abs();

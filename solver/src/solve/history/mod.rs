@@ -48,13 +48,6 @@ pub(crate) struct HistoryState {
     pub worn_saved: Vec<(usize, Vec<f64>)>,
 }
 
-/// How a segment is split into increments.
-#[derive(Clone, Copy, Debug)]
-enum Split {
-    Fixed(usize),
-    Auto(f64),
-}
-
 /// Solves the load path `history` of `spec` from the frictionless normal
 /// solution `normal0` (under the first turning point's normal load) of the
 /// separation `h0`. `check` is applied to every increment's pressure (the
@@ -170,24 +163,14 @@ pub(crate) fn solve_history(
         if let Some(w) = walk.wearing.as_mut() {
             w.set_cycles(segment >= cycles_from);
         }
-        // Fixed increments split every segment alike (every loop is
-        // sampled); auto ones sample the loops of the cycles looked at.
-        let split = match history.increments {
-            Increments::Fixed(k) => Split::Fixed(k),
-            Increments::Auto { .. }
-                if history.sampling.increments > 0 && looked_at.contains(&segment) =>
-            {
-                Split::Fixed(history.sampling.increments)
-            }
-            Increments::Auto { tolerance } => Split::Auto(tolerance),
-        };
-        if let Split::Fixed(_) = split {
+        let split = history.segment_increments(segment, &looked_at);
+        if let Increments::Fixed(_) = split {
             sampled_segments.push(segment);
         }
         let rows_before = walk.rows.len();
         let work_before: f64 = walk.rows.iter().map(|r| r.dissipated_j).sum();
         match split {
-            Split::Fixed(k) => {
+            Increments::Fixed(k) => {
                 for m in 1..=k {
                     let load = along_segment(a, b, m as f64 / k as f64);
                     if load == walk.load {
@@ -198,7 +181,7 @@ pub(crate) fn solve_history(
                     walk.accept(res, trial, segment, &check)?;
                 }
             }
-            Split::Auto(tolerance) => {
+            Increments::Auto { tolerance } => {
                 auto.segment(&mut walk, res, (a, b), segment, tolerance, &check)?;
             }
         }
