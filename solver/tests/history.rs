@@ -5,28 +5,20 @@
 mod common;
 
 use common::md::Md;
-use common::table_1a_fe;
+use common::{fretting_1a, table_1a_fe};
 use solver::{solve_case, CaseSpec, HistoryOutput, KernelCache, LoadHistory};
 
 const P: f64 = 20.0;
 const MU: f64 = 0.28571;
 
 fn fretting(n: usize, spacing_um: f64, amplitude: f64, cycles: usize, steps: usize) -> CaseSpec {
-    let mut ratios = vec![0.0, amplitude];
-    for _ in 0..cycles {
-        ratios.extend([-amplitude, amplitude]);
-    }
-    CaseSpec {
-        history: Some(LoadHistory {
-            tangential_ratios: ratios,
-            normal_forces_n: None,
-            increments: solver::Increments::Fixed(steps),
-            sampling: Default::default(),
-            shifts_m: None,
-            wear: None,
-        }),
-        ..table_1a_fe(n, spacing_um, false, amplitude)
-    }
+    fretting_1a(
+        (n, spacing_um),
+        false,
+        amplitude,
+        cycles,
+        solver::Increments::Fixed(steps),
+    )
 }
 
 fn along(h: &HistoryOutput, v: [f64; 2]) -> f64 {

@@ -9,7 +9,7 @@
 mod common;
 
 use common::md::Md;
-use common::{table_1a_fe, LOAD_1A as P, MU_1A as MU};
+use common::{fretting_1a, table_1a_fe, LOAD_1A as P, MU_1A as MU};
 use solver::{
     solve_case, CaseOutput, CaseSpec, HistoryOutput, Increments, KernelCache, LoadHistory,
     LoopSampling, Wear, WearLaw,
@@ -18,21 +18,7 @@ use solver::{
 /// `cycles` fretting cycles of ±`amplitude` μP after the first loading, in
 /// `increments`, coupled or not.
 fn fretting(coupling: bool, amplitude: f64, cycles: usize, increments: Increments) -> CaseSpec {
-    let mut ratios = vec![0.0, amplitude];
-    for _ in 0..cycles {
-        ratios.extend([-amplitude, amplitude]);
-    }
-    CaseSpec {
-        history: Some(LoadHistory {
-            tangential_ratios: ratios,
-            normal_forces_n: None,
-            increments,
-            sampling: LoopSampling::default(),
-            shifts_m: None,
-            wear: None,
-        }),
-        ..table_1a_fe(128, 2.0, coupling, amplitude)
-    }
+    fretting_1a((128, 2.0), coupling, amplitude, cycles, increments)
 }
 
 fn auto() -> Increments {

@@ -38,6 +38,32 @@ pub fn table_1a_fe(n: usize, spacing_um: f64, coupling: bool, ratio: f64) -> Cas
     }
 }
 
+/// [`table_1a_fe`] on `n` cells of `spacing_um` under `cycles` fretting
+/// cycles of ±`amplitude` μP after the first loading, in `increments`.
+pub fn fretting_1a(
+    (n, spacing_um): (usize, f64),
+    coupling: bool,
+    amplitude: f64,
+    cycles: usize,
+    increments: solver::Increments,
+) -> CaseSpec {
+    let mut ratios = vec![0.0, amplitude];
+    for _ in 0..cycles {
+        ratios.extend([-amplitude, amplitude]);
+    }
+    CaseSpec {
+        history: Some(solver::LoadHistory {
+            tangential_ratios: ratios,
+            normal_forces_n: None,
+            increments,
+            sampling: Default::default(),
+            shifts_m: None,
+            wear: None,
+        }),
+        ..table_1a_fe(n, spacing_um, coupling, amplitude)
+    }
+}
+
 /// Willis's elliptical Hertz contact (`solver::indentation::willis_contact`)
 /// as (a, b, orientation of a from x in rad, p₀), a the long semi-axis.
 pub fn willis(h33: &dyn Fn(f64) -> f64, load: f64, radius: f64) -> (f64, f64, f64, f64) {
